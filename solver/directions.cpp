@@ -1,0 +1,146 @@
+#include "solver/directions.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <utility>
+
+#include "solver/check.h"
+
+namespace leaflux {
+namespace {
+constexpr int kMaxLevel = 4;
+
+bool InsideFace(const glm::dvec3& d, const glm::dvec3& a, const glm::dvec3& b,
+                const glm::dvec3& c) {
+    // Inside the spherical triangle: on the inner side of the three great-circle planes.
+    // A small tolerance keeps directions on an edge inside both faces.
+    constexpr double kTolerance = -1e-12;
+    return glm::dot(glm::cross(a, b), d) >= kTolerance &&
+           glm::dot(glm::cross(b, c), d) >= kTolerance &&
+           glm::dot(glm::cross(c, a), d) >= kTolerance;
+}
+}  // namespace
+
+double SphericalTriangleSolidAngle(const glm::dvec3& a, const glm::dvec3& b,
+                                   const glm::dvec3& c) {
+    const double numerator = std::abs(glm::dot(a, glm::cross(b, c)));
+    const double denominator = 1.0 + glm::dot(a, b) + glm::dot(b, c) + glm::dot(c, a);
+    return 2.0 * std::atan2(numerator, denominator);
+}
+
+DirectionSet::DirectionSet(int level) {
+    LEAFLUX_CHECK(level >= 0 && level <= kMaxLevel);
+    const double s = std::sqrt(8.0 / 9.0), t = std::sqrt(2.0 / 9.0), u = std::sqrt(2.0 / 3.0);
+    directions_ = {{0, 0, 1}, {s, 0, -1.0 / 3}, {-t, u, -1.0 / 3}, {-t, -u, -1.0 / 3}};
+    levels_.push_back({{0, 1, 2}, {0, 2, 3}, {0, 3, 1}, {1, 3, 2}});
+    // Counter-clockwise seen from outside, as InsideFace expects; subdivision keeps it.
+    for (auto& [a, b, c] : levels_[0]) {
+        const glm::dvec3 &pa = directions_[a], &pb = directions_[b], &pc = directions_[c];
+        if (glm::dot(glm::cross(pb - pa, pc - pa), pa + pb + pc) < 0.0) std::swap(b, c);
+    }
+    for (int l = 0; l < level; ++l) {
+        std::map<std::pair<int, int>, int> midpoints;
+        auto midpoint = [&](int i, int j) {
+            const auto key = std::minmax(i, j);
+            if (auto it = midpoints.find(key); it != midpoints.end()) return it->second;
+            directions_.push_back(glm::normalize(directions_[i] + directions_[j]));
+            const int index = static_cast<int>(directions_.size()) - 1;
+            midpoints.emplace(key, index);
+            return index;
+        };
+        std::vector<std::array<int, 3>> children;
+        for (const auto& [a, b, c] : levels_.back()) {
+            const int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+            children.push_back({a, ab, ca});
+            children.push_back({ab, b, bc});
+            children.push_back({ca, bc, c});
+            children.push_back({ab, bc, ca});
+        }
+        levels_.push_back(std::move(children));
+    }
+    faces_ = levels_.back();
+    // Each direction gets a third of the solid angle of every face around it.
+    solidAngles_.assign(directions_.size(), 0.0);
+    for (const auto& [a, b, c] : faces_) {
+        const double third =
+            SphericalTriangleSolidAngle(directions_[a], directions_[b], directions_[c]) / 3.0;
+        solidAngles_[a] += third;
+        solidAngles_[b] += third;
+        solidAngles_[c] += third;
+    }
+}
+
+const DirectionSet& DirectionSet::OfLevel(int level) {
+    static std::once_flag once;
+    static std::array<std::unique_ptr<DirectionSet>, kMaxLevel + 1> sets;
+    std::call_once(once, [] {
+        for (int l = 0; l <= kMaxLevel; ++l) sets[l].reset(new DirectionSet(l));
+    });
+    LEAFLUX_CHECK(level >= 0 && level <= kMaxLevel);
+    return *sets[level];
+}
+
+int DirectionSet::LevelWithCount(int directionCount) {
+    for (int l = 0, count = 4; l <= kMaxLevel; ++l, count = 4 * count - 6) {
+        if (count == directionCount) return l;
+    }
+    return -1;
+}
+
+int DirectionSet::LocateFace(const glm::dvec3& d) const {
+    int face = -1;
+    for (std::size_t l = 0; l < levels_.size(); ++l) {
+        const int first = l == 0 ? 0 : 4 * face;
+        constexpr int count = 4;  // the tetrahedron's faces, then a face's children
+        int found = -1;
+        for (int f = first; f < first + count; ++f) {
+            const auto& [a, b, c] = levels_[l][f];
+            if (InsideFace(d, directions_[a], directions_[b], directions_[c])) {
+                found = f;
+                break;
+            }
+        }
+        // Rounding can leave a direction on an edge outside every child: take the child
+        // whose centre is nearest, which shares that edge.
+        if (found < 0) {
+            double best = -2.0;
+            for (int f = first; f < first + count; ++f) {
+                const auto& [a, b, c] = levels_[l][f];
+                const double cosine =
+                    glm::dot(glm::normalize(directions_[a] + directions_[b] + directions_[c]), d);
+                if (cosine > best) best = cosine, found = f;
+            }
+        }
+        face = found;
+    }
+    return face;
+}
+
+DirectionSet::Interpolation DirectionSet::Locate(const glm::dvec3& direction) const {
+    const glm::dvec3 d = glm::normalize(direction);
+    const auto& [a, b, c] = faces_[LocateFace(d)];
+    // Barycentric weights of the point where d crosses the face's plane (gnomonic).
+    const glm::dvec3 &pa = directions_[a], &pb = directions_[b], &pc = directions_[c];
+    const double wa = glm::dot(glm::cross(pb, pc), d);
+    const double wb = glm::dot(glm::cross(pc, pa), d);
+    const double wc = glm::dot(glm::cross(pa, pb), d);
+    glm::dvec3 w = glm::max(glm::dvec3(wa, wb, wc), glm::dvec3(0.0));
+    const double sum = w.x + w.y + w.z;
+    w = sum > 0.0 ? w / sum : glm::dvec3(1.0, 0.0, 0.0);
+    return {{a, b, c}, {w.x, w.y, w.z}};
+}
+
+int DirectionSet::Nearest(const glm::dvec3& direction) const {
+    const glm::dvec3 d = glm::normalize(direction);
+    const auto& [a, b, c] = faces_[LocateFace(d)];
+    int best = a;
+    for (int v : {b, c}) {
+        if (glm::dot(directions_[v], d) > glm::dot(directions_[best], d)) best = v;
+    }
+    return best;
+}
+
+}  // namespace leaflux

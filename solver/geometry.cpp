@@ -1,0 +1,70 @@
+#include "solver/geometry.h"
+
+#include <limits>
+
+namespace leaflux {
+namespace {
+void AddMesh(const Mesh& mesh, const glm::dmat4& worldFromLocal, Receiver receiver,
+             std::vector<Triangle>& worldTriangles, FlatScene& flat) {
+    receiver.firstTriangle = static_cast<std::uint32_t>(worldTriangles.size());
+    const auto receiverIndex = static_cast<std::uint32_t>(flat.receivers.size());
+    for (const glm::uvec3& tri : mesh.triangles) {
+        Triangle t;
+        t.a = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.x], 1.0));
+        t.b = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.y], 1.0));
+        t.c = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.z], 1.0));
+        const glm::dvec3 cross = glm::cross(t.b - t.a, t.c - t.a);
+        t.areaM2 = 0.5 * glm::length(cross);
+        t.normal = cross / (2.0 * t.areaM2);
+        t.receiver = receiverIndex;
+        receiver.areaM2 += t.areaM2;
+        worldTriangles.push_back(t);
+    }
+    receiver.triangleCount =
+        static_cast<std::uint32_t>(worldTriangles.size()) - receiver.firstTriangle;
+    flat.receivers.push_back(std::move(receiver));
+}
+}  // namespace
+
+FlatScene Flatten(const Scene& scene) {
+    FlatScene flat;
+    std::vector<Triangle> triangles;
+    const auto worldFromLocal = WorldFromLocal(scene);
+    for (const Node& node : scene.nodes) {
+        if (!node.organ) continue;
+        Receiver receiver{scene.NodeName(node), ReceiverKind::kOrgan, node.id,
+                          scene.OpticsIndex(node.organ->opticsId)};
+        AddMesh(*node.organ->mesh, worldFromLocal.at(node.id), receiver, triangles, flat);
+    }
+    for (const Surface& surface : scene.environment) {
+        Receiver receiver{surface.name, ReceiverKind::kEnvironment, 0,
+                          scene.OpticsIndex(surface.opticsId)};
+        AddMesh(*surface.mesh, glm::dmat4(1.0), receiver, triangles, flat);
+    }
+    for (std::size_t e = 0; e < scene.sources.emitters.size(); ++e) {
+        const Emitter& emitter = scene.sources.emitters[e];
+        Receiver receiver{emitter.name, ReceiverKind::kEmitter, 0,
+                          emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId),
+                          static_cast<int>(e)};
+        AddMesh(*emitter.mesh, glm::dmat4(1.0), receiver, triangles, flat);
+    }
+    if (triangles.empty()) return flat;
+
+    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    for (const Triangle& t : triangles) {
+        lo = glm::min(lo, glm::min(t.a, glm::min(t.b, t.c)));
+        hi = glm::max(hi, glm::max(t.a, glm::max(t.b, t.c)));
+    }
+    flat.origin = 0.5 * (lo + hi);
+    for (Triangle& t : triangles) {
+        t.a -= flat.origin;
+        t.b -= flat.origin;
+        t.c -= flat.origin;
+    }
+    flat.boundsMin = lo - flat.origin;
+    flat.boundsMax = hi - flat.origin;
+    flat.triangles = std::move(triangles);
+    return flat;
+}
+
+}  // namespace leaflux

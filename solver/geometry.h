@@ -1,0 +1,54 @@
+// The scene flattened into world-space triangles grouped by receiver — what the ray engine
+// traces and what the solvers light. A receiver is one organ, environment surface or
+// emitter; it is the unit of every per-leaf output.
+//
+// Invariant: triangles of receiver r are [firstTriangle, firstTriangle + triangleCount);
+// positions are stored relative to `origin` (the centre of the scene's bounds) so that a
+// scene 10⁵ m from the world origin keeps its millimetres in single precision.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "solver/scene.h"
+
+namespace leaflux {
+
+enum class ReceiverKind { kOrgan, kEnvironment, kEmitter };
+
+struct Receiver {
+    std::string name;
+    ReceiverKind kind = ReceiverKind::kOrgan;
+    NodeId node = 0;           // the organ's node; 0 for environment surfaces and emitters
+    int optics = -1;           // index into Scene::optics; -1: black (an emitter without optics)
+    int emitter = -1;          // index into Sources::emitters when kind == kEmitter
+    double areaM2 = 0.0;
+    std::uint32_t firstTriangle = 0;
+    std::uint32_t triangleCount = 0;
+};
+
+struct Triangle {
+    glm::dvec3 a, b, c;         // relative to FlatScene::origin
+    glm::dvec3 normal;          // unit, right-hand rule on a, b, c: the upper side
+    double areaM2;
+    std::uint32_t receiver;
+};
+
+struct FlatScene {
+    glm::dvec3 origin{0.0};            // world position of the local frame's origin
+    glm::dvec3 boundsMin{0.0}, boundsMax{0.0};  // local frame
+    std::vector<Triangle> triangles;
+    std::vector<Receiver> receivers;
+
+    bool Empty() const { return triangles.empty(); }
+    glm::dvec3 ToLocal(const glm::dvec3& world) const { return world - origin; }
+};
+
+// Flattens a validated scene. Receivers come in scene order: organs, environment, emitters.
+FlatScene Flatten(const Scene& scene);
+
+}  // namespace leaflux

@@ -1,0 +1,77 @@
+// The light a solver computed: the one output format every solver fills, so that any two
+// can be compared on the same scene (DESIGN §3).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "solver/geometry.h"
+
+namespace leaflux {
+
+// The light on one receiver in one band.
+struct BandLight {
+    double irradianceUpperWm2 = 0.0;  // mean over the receiver, arriving on the upper side
+    double irradianceLowerWm2 = 0.0;
+    double absorbedW = 0.0;
+    // ∫ L(ω) dω and ∫ L(ω) ω dω over the whole sphere (W/m²): the light vector is their
+    // ratio (DESIGN §2); kept apart so that structures can aggregate them.
+    double radianceIntegral = 0.0;
+    glm::dvec3 radianceMoment{0.0};
+    // Standard errors (Monte Carlo); negative when the solver gives none.
+    double stderrUpperWm2 = -1.0;
+    double stderrLowerWm2 = -1.0;
+    double stderrAbsorbedW = -1.0;
+
+    // Towards where the light comes from: |v| = 1 for one beam, 0 for isotropic light.
+    glm::dvec3 LightVector() const {
+        return radianceIntegral > 0.0 ? radianceMoment / radianceIntegral : glm::dvec3(0.0);
+    }
+};
+
+// Where the light of one band went, in W: incident = absorbed + escaped for a converged,
+// energy-conserving solution.
+struct EnergyBalance {
+    double incidentW = 0.0;  // from the sources onto any surface (first arrival)
+    double absorbedW = 0.0;  // by every surface
+    double escapedW = 0.0;   // leaving the scene after at least one scattering
+    double stderrW = -1.0;   // standard error of incident − absorbed − escaped
+
+    double RelativeResidual() const {
+        return incidentW > 0.0 ? (incidentW - absorbedW - escapedW) / incidentW : 0.0;
+    }
+};
+
+struct SolveStats {
+    double wallSeconds = 0.0;
+    double cpuSeconds = 0.0;
+    std::int64_t peakRssBytes = 0;
+    std::int64_t rays = 0;
+    int threads = 0;
+};
+
+struct Solution {
+    std::vector<std::vector<BandLight>> light;  // [receiver][band]
+    std::vector<EnergyBalance> balance;         // [band]
+    SolveStats stats;
+};
+
+// The same quantities for a botanical structure (branch, plant, …): the organs below it,
+// area-weighted for irradiances, summed for absorbed power and radiance integrals.
+struct StructureLight {
+    NodeId node = 0;
+    std::string name;
+    NodeType type = NodeType::kOther;
+    int organCount = 0;
+    double areaM2 = 0.0;
+    std::vector<BandLight> bands;
+};
+
+// Aggregates for every node that has organs below it (itself included).
+std::vector<StructureLight> AggregateStructures(const Scene& scene, const FlatScene& flat,
+                                                const Solution& solution);
+
+}  // namespace leaflux

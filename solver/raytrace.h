@@ -1,0 +1,95 @@
+// The ray engine: RAII handles around Embree 3 and the two queries every solver needs,
+// closest hit and occlusion, on a FlatScene — optionally repeated periodically in x and y.
+//
+// A RayScene is committed once in its constructor and read-only afterwards: trace it from
+// any number of threads; to change the geometry, build a new one (rebuild after a change).
+// Nothing invalid reaches Embree: FlatScene comes from a validated Scene.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+
+#include <embree3/rtcore.h>
+#include <glm/glm.hpp>
+
+#include "solver/geometry.h"
+
+namespace leaflux {
+
+// Sets flush-to-zero and denormals-are-zero on the calling thread, as Embree asks.
+void SetFlushToZero();
+
+class RayDevice {
+public:
+    RayDevice();
+    ~RayDevice();
+    RayDevice(const RayDevice&) = delete;
+    RayDevice& operator=(const RayDevice&) = delete;
+
+    RTCDevice Get() const { return device_; }
+    // One device for the process; Embree devices are thread-safe.
+    static std::shared_ptr<RayDevice> Shared();
+
+private:
+    RTCDevice device_;
+};
+
+inline constexpr std::uint32_t kNoTriangle = std::numeric_limits<std::uint32_t>::max();
+
+// Where a ray starts: a point (FlatScene local frame) and, when it leaves a surface, that
+// surface's triangle, which the ray then never hits again (robust without an offset, even
+// between leaves 1 µm apart).
+struct RayStart {
+    glm::dvec3 origin;
+    std::uint32_t triangle = kNoTriangle;
+    int copy = 0;  // which periodic copy of `triangle` the origin is on (0 in a plain scene)
+};
+
+enum class RayFate { kHit, kEscapedUp, kEscapedDown, kEscaped };
+
+struct RayHit {
+    RayFate fate = RayFate::kEscaped;
+    std::uint32_t triangle = kNoTriangle;
+    double distance = std::numeric_limits<double>::infinity();
+    RayStart next;  // the hit point as the start of the next ray (kHit only)
+};
+
+class RayScene {
+public:
+    // `periodic`: the tile, in the FlatScene's local frame, repeated in x and y. Geometry
+    // may overhang the tile by less than one tile width.
+    RayScene(const FlatScene& flat, std::optional<PeriodicDomain> periodic,
+             std::shared_ptr<RayDevice> device = RayDevice::Shared());
+    ~RayScene();
+    RayScene(const RayScene&) = delete;
+    RayScene& operator=(const RayScene&) = delete;
+
+    // The first surface along the ray. In a periodic scene a ray that leaves the tile
+    // sideways re-enters on the other side; it escapes up or down past the scene's bounds.
+    RayHit Trace(const RayStart& start, const glm::dvec3& direction) const;
+
+    // Whether anything lies along the ray within maxDistance (infinity: to the sky).
+    bool Occluded(const RayStart& start, const glm::dvec3& direction,
+                  double maxDistance = std::numeric_limits<double>::infinity()) const;
+
+    const FlatScene& Flat() const { return flat_; }
+    bool Periodic() const { return periodic_.has_value(); }
+
+private:
+    RayHit TraceOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const;
+    bool OccludedOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const;
+    // Wraps a start into the tile; returns the distance to the tile's side along direction.
+    double IntoTile(RayStart& start, const glm::dvec3& direction) const;
+    // Moves `at` to where it leaves the tile; false when it has left the scene up or down.
+    bool StepToTileSide(RayStart& at, const glm::dvec3& direction, double toSide) const;
+
+    const FlatScene& flat_;
+    std::optional<PeriodicDomain> periodic_;
+    std::shared_ptr<RayDevice> device_;
+    RTCScene mesh_ = nullptr;  // the triangles
+    RTCScene top_ = nullptr;   // the triangles, or 9 instances of them in a periodic scene
+};
+
+}  // namespace leaflux

@@ -1,0 +1,278 @@
+#include "solver/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "solver/error.h"
+
+namespace leaflux {
+namespace {
+
+bool Finite(const glm::dvec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+void Require(bool condition, ErrorCode code, const std::string& field, const std::string& message,
+             std::optional<NodeId> node = std::nullopt) {
+    if (!condition) throw InputError(code, field, message, node);
+}
+
+void RequireFraction(double value, const std::string& field) {
+    Require(std::isfinite(value) && value >= 0.0 && value <= 1.0, ErrorCode::kInvalidArgument,
+            field, "must be a finite number in [0, 1], got " + std::to_string(value));
+}
+
+void RequirePerBand(const Scene& scene, const std::vector<double>& values,
+                    const std::string& field) {
+    Require(values.size() == scene.bands.size(), ErrorCode::kInvalidArgument, field,
+            "needs one value per band (" + std::to_string(scene.bands.size()) + "), got " +
+                std::to_string(values.size()));
+    for (std::size_t b = 0; b < values.size(); ++b) {
+        Require(std::isfinite(values[b]) && values[b] >= 0.0, ErrorCode::kInvalidArgument,
+                field + "[" + scene.bands[b].name + "]",
+                "must be finite and non-negative, got " + std::to_string(values[b]));
+    }
+}
+
+// A triangle is degenerate when its area vanishes against its edges: the sine of its
+// largest angle's complement is below 1e-9 (a sliver Embree would lose in float).
+void ValidateMesh(const Mesh* mesh, const glm::dmat4& worldFromLocal, const std::string& field,
+                  std::optional<NodeId> node) {
+    Require(mesh != nullptr, ErrorCode::kInvalidArgument, field, "has no mesh", node);
+    Require(!mesh->triangles.empty(), ErrorCode::kDegenerate, field + ".triangles",
+            "mesh has no triangle", node);
+    for (std::size_t i = 0; i < mesh->positions.size(); ++i) {
+        Require(Finite(mesh->positions[i]), ErrorCode::kInvalidArgument,
+                field + ".positions[" + std::to_string(i) + "]", "is not finite", node);
+    }
+    const auto vertexCount = static_cast<unsigned>(mesh->positions.size());
+    for (std::size_t t = 0; t < mesh->triangles.size(); ++t) {
+        const glm::uvec3& tri = mesh->triangles[t];
+        const std::string at = field + ".triangles[" + std::to_string(t) + "]";
+        Require(tri.x < vertexCount && tri.y < vertexCount && tri.z < vertexCount,
+                ErrorCode::kInvalidArgument, at,
+                "refers to a vertex beyond the " + std::to_string(vertexCount) + " positions",
+                node);
+        const glm::dvec3 a = glm::dvec3(worldFromLocal * glm::dvec4(mesh->positions[tri.x], 1.0));
+        const glm::dvec3 b = glm::dvec3(worldFromLocal * glm::dvec4(mesh->positions[tri.y], 1.0));
+        const glm::dvec3 c = glm::dvec3(worldFromLocal * glm::dvec4(mesh->positions[tri.z], 1.0));
+        Require(Finite(a) && Finite(b) && Finite(c), ErrorCode::kInvalidArgument, at,
+                "has non-finite world coordinates", node);
+        const double twiceArea = glm::length(glm::cross(b - a, c - a));
+        const double longest =
+            std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+        Require(twiceArea > 1e-9 * longest * longest && twiceArea > 1e-18,
+                ErrorCode::kDegenerate, at, "has zero area (collapsed or repeated vertices)",
+                node);
+    }
+}
+
+void ValidateOptics(const Scene& scene) {
+    std::set<std::string> ids;
+    for (const Optics& optics : scene.optics) {
+        const std::string field = "optics[" + optics.id + "]";
+        Require(!optics.id.empty(), ErrorCode::kInvalidArgument, "optics.id", "is empty");
+        Require(ids.insert(optics.id).second, ErrorCode::kAlreadyExists, field,
+                "is declared twice");
+        Require(optics.bands.size() == scene.bands.size(), ErrorCode::kNotFound, field + ".bands",
+                "needs properties for each of the " + std::to_string(scene.bands.size()) +
+                    " bands");
+        for (std::size_t b = 0; b < optics.bands.size(); ++b) {
+            const BandOptics& o = optics.bands[b];
+            const std::string at = field + ".bands[" + scene.bands[b].name + "]";
+            RequireFraction(o.rhoUpper, at + ".rho_upper");
+            RequireFraction(o.rhoLower, at + ".rho_lower");
+            RequireFraction(o.tauUpperToLower, at + ".tau_upper");
+            RequireFraction(o.tauLowerToUpper, at + ".tau_lower");
+            Require(o.rhoUpper + o.tauUpperToLower <= 1.0, ErrorCode::kInvalidArgument, at,
+                    "rho_upper + tau_upper exceeds 1: the upper side would create light");
+            Require(o.rhoLower + o.tauLowerToUpper <= 1.0, ErrorCode::kInvalidArgument, at,
+                    "rho_lower + tau_lower exceeds 1: the lower side would create light");
+        }
+    }
+}
+
+void RequireOptics(const Scene& scene, const std::string& id, const std::string& field,
+                   std::optional<NodeId> node) {
+    Require(scene.OpticsIndex(id) >= 0, ErrorCode::kNotFound, field,
+            "names unknown optics '" + id + "'", node);
+}
+
+void ValidateTopology(const Scene& scene, std::set<std::string>& names) {
+    std::unordered_map<NodeId, const Node*> byId;
+    for (const Node& node : scene.nodes) {
+        Require(node.id != 0, ErrorCode::kInvalidArgument, "nodes.id", "0 is not a valid id");
+        Require(byId.emplace(node.id, &node).second, ErrorCode::kAlreadyExists, "nodes.id",
+                "the id is used by two nodes", node.id);
+    }
+    for (const Node& node : scene.nodes) {
+        Require(node.parent == kNoParent || byId.count(node.parent), ErrorCode::kNotFound,
+                "parent", "names unknown node " + std::to_string(node.parent), node.id);
+        for (int c = 0; c < 4; ++c) {
+            for (int r = 0; r < 4; ++r) {
+                Require(std::isfinite(node.parentFromLocal[c][r]), ErrorCode::kInvalidArgument,
+                        "frame", "is not finite", node.id);
+            }
+        }
+        Require(std::abs(glm::determinant(glm::dmat3(node.parentFromLocal))) > 1e-30,
+                ErrorCode::kDegenerate, "frame", "is singular", node.id);
+        Require(std::isfinite(node.age), ErrorCode::kInvalidArgument, "age", "is not finite",
+                node.id);
+        for (const auto& [key, value] : node.attributes) {
+            Require(std::isfinite(value), ErrorCode::kInvalidArgument, "attributes[" + key + "]",
+                    "is not finite", node.id);
+        }
+    }
+    // Cycles: walk up from each node; a walk longer than the node count loops.
+    std::unordered_set<NodeId> rooted;
+    for (const Node& node : scene.nodes) {
+        std::vector<NodeId> path;
+        NodeId at = node.id;
+        while (at != kNoParent && !rooted.count(at)) {
+            path.push_back(at);
+            Require(path.size() <= scene.nodes.size(), ErrorCode::kCycle, "parent",
+                    "the parent links of this node loop", node.id);
+            at = byId.at(at)->parent;
+        }
+        rooted.insert(path.begin(), path.end());
+    }
+    const auto worldFromLocal = WorldFromLocal(scene);
+    for (const Node& node : scene.nodes) {
+        if (!node.organ) continue;
+        RequireOptics(scene, node.organ->opticsId, "organ.optics", node.id);
+        ValidateMesh(node.organ->mesh.get(), worldFromLocal.at(node.id), "organ.mesh", node.id);
+        Require(names.insert(scene.NodeName(node)).second, ErrorCode::kAlreadyExists, "name",
+                "organ name '" + scene.NodeName(node) + "' is used twice", node.id);
+    }
+}
+
+void ValidateSources(const Scene& scene, std::set<std::string>& names) {
+    for (std::size_t i = 0; i < scene.sources.suns.size(); ++i) {
+        const Sun& sun = scene.sources.suns[i];
+        const std::string field = "suns[" + std::to_string(i) + "]";
+        Require(Finite(sun.towardSun) && std::abs(glm::length(sun.towardSun) - 1.0) < 1e-6,
+                ErrorCode::kInvalidArgument, field + ".direction", "must be a finite unit vector");
+        RequirePerBand(scene, sun.normalIrradianceWm2, field + ".normal_irradiance");
+        Require(std::isfinite(sun.angularRadiusRad) && sun.angularRadiusRad >= 0.0 &&
+                    sun.angularRadiusRad <= 0.2,
+                ErrorCode::kInvalidArgument, field + ".angular_radius_deg",
+                "must be between 0 and about 11 degrees");
+    }
+    for (const Sky& sky : scene.sources.skies) {
+        RequirePerBand(scene, sky.horizontalIrradianceWm2, "sky.horizontal_irradiance");
+    }
+    for (std::size_t i = 0; i < scene.sources.emitters.size(); ++i) {
+        const Emitter& emitter = scene.sources.emitters[i];
+        const std::string field = "emitters[" + emitter.name + "]";
+        Require(!emitter.name.empty(), ErrorCode::kInvalidArgument,
+                "emitters[" + std::to_string(i) + "].name", "is empty");
+        ValidateMesh(emitter.mesh.get(), glm::dmat4(1.0), field + ".mesh", std::nullopt);
+        RequirePerBand(scene, emitter.exitanceWm2, field + ".exitance");
+        if (!emitter.opticsId.empty()) RequireOptics(scene, emitter.opticsId, field + ".optics", {});
+        Require(names.insert(emitter.name).second, ErrorCode::kAlreadyExists, field + ".name",
+                "the name is used twice");
+    }
+}
+
+}  // namespace
+
+const char* NodeTypeName(NodeType type) {
+    switch (type) {
+        case NodeType::kPlant: return "plant";
+        case NodeType::kAxis: return "axis";
+        case NodeType::kPhytomer: return "phytomer";
+        case NodeType::kLeaf: return "leaf";
+        case NodeType::kInternode: return "internode";
+        case NodeType::kFruit: return "fruit";
+        case NodeType::kOther: return "other";
+    }
+    return "other";
+}
+
+int Scene::BandIndex(const std::string& name) const {
+    for (std::size_t b = 0; b < bands.size(); ++b) {
+        if (bands[b].name == name) return static_cast<int>(b);
+    }
+    return -1;
+}
+
+int Scene::OpticsIndex(const std::string& id) const {
+    for (std::size_t o = 0; o < optics.size(); ++o) {
+        if (optics[o].id == id) return static_cast<int>(o);
+    }
+    return -1;
+}
+
+std::string Scene::NodeName(const Node& node) const {
+    return node.name.empty() ? "node" + std::to_string(node.id) : node.name;
+}
+
+void Scene::Validate() const {
+    Require(!bands.empty(), ErrorCode::kInvalidArgument, "bands", "at least one band is needed");
+    Require(bands.size() <= static_cast<std::size_t>(kMaxBands), ErrorCode::kInvalidArgument,
+            "bands", "at most " + std::to_string(kMaxBands) + " bands are supported");
+    std::set<std::string> bandNames;
+    for (const Band& band : bands) {
+        Require(!band.name.empty(), ErrorCode::kInvalidArgument, "bands.name", "is empty");
+        Require(bandNames.insert(band.name).second, ErrorCode::kAlreadyExists,
+                "bands[" + band.name + "]", "is declared twice");
+    }
+    ValidateOptics(*this);
+    std::set<std::string> names;
+    ValidateTopology(*this, names);
+    for (std::size_t i = 0; i < environment.size(); ++i) {
+        const Surface& surface = environment[i];
+        const std::string field = "environment[" + surface.name + "]";
+        Require(!surface.name.empty(), ErrorCode::kInvalidArgument,
+                "environment[" + std::to_string(i) + "].name", "is empty");
+        RequireOptics(*this, surface.opticsId, field + ".optics", {});
+        ValidateMesh(surface.mesh.get(), glm::dmat4(1.0), field + ".mesh", std::nullopt);
+        Require(names.insert(surface.name).second, ErrorCode::kAlreadyExists, field + ".name",
+                "the name is used twice");
+    }
+    ValidateSources(*this, names);
+    if (periodic) {
+        Require(std::isfinite(periodic->xMin) && std::isfinite(periodic->xMax) &&
+                    std::isfinite(periodic->yMin) && std::isfinite(periodic->yMax) &&
+                    periodic->xMax > periodic->xMin && periodic->yMax > periodic->yMin,
+                ErrorCode::kInvalidArgument, "periodic", "needs x_min < x_max and y_min < y_max");
+    }
+}
+
+std::map<NodeId, glm::dmat4> WorldFromLocal(const Scene& scene) {
+    std::unordered_map<NodeId, const Node*> byId;
+    for (const Node& node : scene.nodes) byId.emplace(node.id, &node);
+    std::map<NodeId, glm::dmat4> result;
+    for (const Node& node : scene.nodes) {
+        // Collect the unresolved ancestors, then compose downwards.
+        std::vector<const Node*> chain;
+        for (const Node* at = &node; at && !result.count(at->id);
+             at = at->parent == kNoParent ? nullptr : byId.at(at->parent)) {
+            chain.push_back(at);
+            if (chain.size() > scene.nodes.size()) return result;  // a cycle: Validate reports it
+        }
+        for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+            const Node* at = *it;
+            const glm::dmat4 worldFromParent =
+                at->parent == kNoParent ? glm::dmat4(1.0) : result.at(at->parent);
+            result[at->id] = worldFromParent * at->parentFromLocal;
+        }
+    }
+    return result;
+}
+
+double MeshArea(const Mesh& mesh, const glm::dmat4& worldFromLocal) {
+    double area = 0.0;
+    for (const glm::uvec3& tri : mesh.triangles) {
+        const glm::dvec3 a = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.x], 1.0));
+        const glm::dvec3 b = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.y], 1.0));
+        const glm::dvec3 c = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.z], 1.0));
+        area += 0.5 * glm::length(glm::cross(b - a, c - a));
+    }
+    return area;
+}
+
+}  // namespace leaflux

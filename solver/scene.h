@@ -1,0 +1,107 @@
+// The scene as a growth model sees it: bands, optics, a botanical topology whose organs
+// carry meshes, a static environment, sources and an optional periodic domain.
+//
+// Invariant after Validate(): every value is finite and in its domain, every reference
+// (parent, optics, band) resolves, the topology is a forest, every triangle has a positive
+// area. Meshes are shared (std::shared_ptr<const Mesh>) so that organs built from one
+// prototype — an OPF mesh, a leaf shape — keep that sharing: it is instancing data.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "solver/sources.h"
+
+namespace leaflux {
+
+using NodeId = std::uint64_t;
+inline constexpr NodeId kNoParent = 0;
+// Bands carry fixed-size arrays in hot loops; a session declares at most this many.
+inline constexpr int kMaxBands = 8;
+
+enum class NodeType { kPlant, kAxis, kPhytomer, kLeaf, kInternode, kFruit, kOther };
+const char* NodeTypeName(NodeType type);
+
+struct Band {
+    std::string name;
+    double wavelengthMinNm = 0.0;  // 0 when unknown
+    double wavelengthMaxNm = 0.0;
+};
+
+// A triangle mesh in its owner's local frame (metres). The upper side of a triangle is the
+// side its normal (right-hand rule on the vertex order) points to.
+struct Mesh {
+    std::vector<glm::dvec3> positions;
+    std::vector<glm::uvec3> triangles;
+};
+
+// Diffuse properties of one band (Soler 2003 §4.3). Opaque surfaces have τ = 0.
+struct BandOptics {
+    double rhoUpper = 0.0;
+    double rhoLower = 0.0;
+    double tauUpperToLower = 0.0;  // of light arriving on the upper side
+    double tauLowerToUpper = 0.0;  // of light arriving on the lower side
+};
+
+struct Optics {
+    std::string id;
+    std::vector<BandOptics> bands;  // one per scene band, in scene band order
+};
+
+struct Organ {
+    std::shared_ptr<const Mesh> mesh;
+    std::string opticsId;
+};
+
+struct Node {
+    NodeId id = 0;
+    NodeId parent = kNoParent;
+    NodeType type = NodeType::kOther;
+    std::string name;                      // empty: "node<id>"
+    glm::dmat4 parentFromLocal{1.0};       // affine; z along the structure's main axis
+    double age = 0.0;                      // physiological age
+    std::map<std::string, double> attributes;
+    std::optional<Organ> organ;
+};
+
+// Static environment surface (ground, wall, obstacle), in world coordinates.
+struct Surface {
+    std::string name;
+    std::shared_ptr<const Mesh> mesh;
+    std::string opticsId;
+};
+
+// The scene is one tile of an infinite canopy, repeated along x and y.
+struct PeriodicDomain {
+    double xMin = 0.0, yMin = 0.0, xMax = 0.0, yMax = 0.0;
+};
+
+struct Scene {
+    std::vector<Band> bands;
+    std::vector<Optics> optics;
+    std::vector<Node> nodes;
+    std::vector<Surface> environment;
+    Sources sources;
+    std::optional<PeriodicDomain> periodic;
+
+    int BandIndex(const std::string& name) const;          // -1 when absent
+    int OpticsIndex(const std::string& id) const;          // -1 when absent
+    std::string NodeName(const Node& node) const;
+
+    // Checks the invariant above; throws InputError naming the field or node otherwise.
+    void Validate() const;
+};
+
+// worldFromLocal of every node, by id. Requires a validated scene (no cycles).
+std::map<NodeId, glm::dmat4> WorldFromLocal(const Scene& scene);
+
+// Area (m²) of a triangle mesh after applying worldFromLocal.
+double MeshArea(const Mesh& mesh, const glm::dmat4& worldFromLocal);
+
+}  // namespace leaflux
