@@ -24,7 +24,7 @@ namespace leaflux {
 
 struct ReferenceOptions {
     int samplesPerReceiver = 1024;  // paths per receiver, rounded up to replicates · m²
-    int replicates = 8;             // independent groups for the standard error (≥ 2)
+    int replicates = 16;            // independent groups for the standard error (≥ 2)
     std::uint64_t seed = 1;
     int threads = 0;                // 0: every core
     int maxDepth = 100000;          // a safety net: with Russian roulette at ≤ 0.995,

@@ -78,6 +78,26 @@ CellIntegration Integrate(SkyDiscretization discretization) {
     return result;
 }
 
+// ∫ |ω_z| dω over the cap of solid angle `solidAngle` around `axis`, by a midpoint rule
+// in (cos θ, φ) about the axis, uniform in solid angle (relative error below 1e-6).
+double CapIntegralOfAbsZ(const glm::dvec3& axis, double solidAngle) {
+    constexpr int kRings = 64, kSectors = 128;
+    const double cosMax = 1.0 - solidAngle / (2.0 * kPi);
+    glm::dvec3 t = std::abs(axis.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0);
+    t = glm::normalize(glm::cross(axis, t));
+    const glm::dvec3 b = glm::cross(axis, t);
+    double sum = 0.0;
+    for (int i = 0; i < kRings; ++i) {
+        const double z = 1.0 - (i + 0.5) / kRings * (1.0 - cosMax);
+        const double r = std::sqrt(1.0 - z * z);
+        for (int j = 0; j < kSectors; ++j) {
+            const double phi = 2.0 * kPi * (j + 0.5) / kSectors;
+            sum += std::abs((r * std::cos(phi) * t + r * std::sin(phi) * b + z * axis).z);
+        }
+    }
+    return sum * solidAngle / (kRings * kSectors);
+}
+
 const CellIntegration& CellsOf(SkyDiscretization discretization) {
     static std::once_flag once;
     static std::array<CellIntegration, 5> cache;
@@ -174,11 +194,17 @@ std::vector<SkyCone> Sky::Cones() const {
             cone.radianceWm2Sr[b] += Radiance(b, integration.pointDirections[i]);
         }
     }
+    // Irradiance each cone gives a horizontal plane per unit radiance: ∫ |z| over its cap,
+    // the part below the horizon folded up as the solvers fold it.
+    std::vector<double> horizontalPerRadiance;
+    for (const SkyCone& cone : cones) {
+        horizontalPerRadiance.push_back(CapIntegralOfAbsZ(cone.direction, cone.solidAngleSr));
+    }
     for (int b = 0; b < bands; ++b) {
         double horizontal = 0.0;
         for (std::size_t c = 0; c < cones.size(); ++c) {
             cones[c].radianceWm2Sr[b] /= points[c];
-            horizontal += cones[c].radianceWm2Sr[b] * cones[c].solidAngleSr * cones[c].direction.z;
+            horizontal += cones[c].radianceWm2Sr[b] * horizontalPerRadiance[c];
         }
         const double scale = horizontal > 0.0 ? horizontalIrradianceWm2[b] / horizontal : 0.0;
         for (SkyCone& cone : cones) cone.radianceWm2Sr[b] *= scale;

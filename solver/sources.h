@@ -58,9 +58,11 @@ struct Sky {
     // normalised so that ∫ L cos θ dω over the upper hemisphere is the horizontal irradiance.
     double Radiance(int band, const glm::dvec3& towardSky) const;
 
-    // The cones of `discretization` (empty when continuous). Their radiance is the model's
-    // mean over each cone's cell and is renormalised so the cones give the horizontal
-    // irradiance exactly: the discretisation moves light, it neither adds nor removes any.
+    // The cones of `discretization` (empty when continuous): each a cap of its cell's solid
+    // angle around the cell's centroid, of uniform radiance inside. The radiance is the
+    // model's mean over the cell, renormalised so that the caps — with the part of a cap
+    // below the horizon folded above it — give the horizontal irradiance exactly: the
+    // discretisation moves light between directions, it neither adds nor removes any.
     std::vector<SkyCone> Cones() const;
 };
 

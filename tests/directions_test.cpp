@@ -1,0 +1,60 @@
+#include <gtest/gtest.h>
+
+#include "solver/directions.h"
+#include "solver/sampling.h"
+
+namespace leaflux {
+namespace {
+
+TEST(DirectionSet, HasTheTetrahedralCounts) {
+    const int counts[] = {4, 10, 34, 130, 514};
+    for (int level = 0; level <= 4; ++level) {
+        EXPECT_EQ(DirectionSet::OfLevel(level).Size(), counts[level]);
+        EXPECT_EQ(DirectionSet::LevelWithCount(counts[level]), level);
+    }
+    EXPECT_EQ(DirectionSet::LevelWithCount(46), -1);
+}
+
+TEST(DirectionSet, SolidAnglesCoverTheSphere) {
+    for (int level = 0; level <= 4; ++level) {
+        const DirectionSet& set = DirectionSet::OfLevel(level);
+        double total = 0.0;
+        for (int i = 0; i < set.Size(); ++i) {
+            EXPECT_GT(set.SolidAngleSr(i), 0.0);
+            total += set.SolidAngleSr(i);
+        }
+        EXPECT_NEAR(total, 4.0 * glm::pi<double>(), 1e-9);
+    }
+}
+
+TEST(DirectionSet, InterpolationReproducesLinearFunctionsAtVertices) {
+    const DirectionSet& set = DirectionSet::OfLevel(3);
+    for (int i = 0; i < set.Size(); ++i) {
+        const auto located = set.Locate(set.Direction(i));
+        double weightOfVertex = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            if (located.vertex[k] == i) weightOfVertex += located.weight[k];
+        }
+        EXPECT_NEAR(weightOfVertex, 1.0, 1e-9) << "direction " << i;
+    }
+}
+
+TEST(DirectionSet, EveryDirectionLiesInAFaceWithValidWeights) {
+    const DirectionSet& set = DirectionSet::OfLevel(4);
+    Random random(3);
+    for (int i = 0; i < 20000; ++i) {
+        const glm::dvec3 d = UniformSphere(random.Uniform(), random.Uniform());
+        const auto located = set.Locate(d);
+        double sum = 0.0;
+        for (double w : located.weight) {
+            EXPECT_GE(w, 0.0);
+            sum += w;
+        }
+        EXPECT_NEAR(sum, 1.0, 1e-12);
+        // The face is the one around d: its vertices are within one face size.
+        for (int v : located.vertex) EXPECT_GT(glm::dot(set.Direction(v), d), 0.95);
+    }
+}
+
+}  // namespace
+}  // namespace leaflux

@@ -1,0 +1,195 @@
+// The Monte Carlo reference against closed forms (shared/data/README.md). Every tolerance
+// is a multiple of the standard error the solver reports. That error comes from the spread
+// of kReplicates independent replicate means, so (value − truth) / error follows Student's
+// t with kReplicates − 1 degrees of freedom: kSigmas is its two-sided 1e-4 quantile. Where
+// geometry only approximates the closed form (a 256-gon for a disc) the bound adds that
+// error, stated.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "solver/reference.h"
+#include "tests/scene_builders.h"
+
+namespace leaflux {
+namespace {
+using namespace leaflux::testing;
+
+constexpr int kReplicates = 32;
+constexpr double kSigmas = 4.6;  // t quantile, 31 degrees of freedom, 1 − 5e-5
+// Floating-point rounding of sums of identical samples (an estimate with zero variance).
+constexpr double kRounding = 1e-9;
+
+struct Solved {
+    FlatScene flat;
+    Solution solution;
+    const BandLight& Of(const std::string& name, int band = 0) const {
+        for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
+            if (flat.receivers[r].name == name) return solution.light[r][band];
+        }
+        throw std::runtime_error("no receiver " + name);
+    }
+};
+
+Solved Solve(const Scene& scene, int samples = 4096, std::uint64_t seed = 7, int threads = 0) {
+    scene.Validate();
+    Solved solved{Flatten(scene), {}};
+    std::optional<PeriodicDomain> periodic;
+    if (scene.periodic) {
+        periodic = *scene.periodic;
+        periodic->xMin -= solved.flat.origin.x;
+        periodic->xMax -= solved.flat.origin.x;
+        periodic->yMin -= solved.flat.origin.y;
+        periodic->yMax -= solved.flat.origin.y;
+    }
+    RayScene rays(solved.flat, periodic);
+    ReferenceOptions options;
+    options.samplesPerReceiver = samples;
+    options.seed = seed;
+    options.threads = threads;
+    options.replicates = kReplicates;
+    solved.solution = SolveReference(scene, solved.flat, rays, options);
+    return solved;
+}
+
+void ExpectWithin(double value, double expected, double stderrValue, double extra = 0.0) {
+    EXPECT_NEAR(value, expected,
+                kSigmas * stderrValue + kRounding * std::abs(expected) + extra)
+        << "standard error " << stderrValue;
+}
+
+TEST(SinglePlate, UnderSunGetsSinOfElevationOnTop) {
+    Scene scene = OneBandScene({{"black", Leaf(0, 0)}});
+    scene.nodes.push_back(OrganNode(1, "plate", Rectangle(1, 1, 0), "black"));
+    scene.sources.suns.push_back(SunAt(30, 120, 1000));
+    const Solved solved = Solve(scene, 256);
+    const BandLight& light = solved.Of("plate");
+    ExpectWithin(light.irradianceUpperWm2, 500.0, light.stderrUpperWm2);
+    EXPECT_EQ(light.irradianceLowerWm2, 0.0);
+    ExpectWithin(light.absorbedW, 500.0, light.stderrAbsorbedW);
+    // One collimated beam: the light vector is the unit vector towards the sun.
+    const glm::dvec3 v = light.LightVector();
+    EXPECT_NEAR(glm::length(v), 1.0, 1e-12);
+    EXPECT_NEAR(glm::dot(v, scene.sources.suns[0].towardSun), 1.0, 1e-12);
+}
+
+TEST(SinglePlate, UnderUniformSkyGetsPiL) {
+    Scene scene = OneBandScene({{"black", Leaf(0, 0)}});
+    scene.nodes.push_back(OrganNode(1, "plate", Rectangle(1, 1, 0), "black"));
+    const double radiance = 100.0;
+    scene.sources.skies.push_back({SkyModel::kUniform, {kPi * radiance}});
+    const Solved solved = Solve(scene, 16384);
+    const BandLight& light = solved.Of("plate");
+    ExpectWithin(light.irradianceUpperWm2, kPi * radiance, light.stderrUpperWm2);
+    EXPECT_EQ(light.irradianceLowerWm2, 0.0);
+    // Light from the whole upper hemisphere: the light vector points up, |v| = 1/2.
+    EXPECT_NEAR(light.LightVector().z, 0.5, 0.02);
+}
+
+TEST(SinglePlate, UnderDiscretisedSkyKeepsTheHorizontalIrradiance) {
+    for (auto discretization : {SkyDiscretization::kTurtle46, SkyDiscretization::kTetra130}) {
+        Scene scene = OneBandScene({{"black", Leaf(0, 0)}});
+        scene.nodes.push_back(OrganNode(1, "plate", Rectangle(1, 1, 0), "black"));
+        scene.sources.skies.push_back({SkyModel::kCieOvercast, {300.0}, discretization});
+        const Solved solved = Solve(scene, 16384);
+        const BandLight& light = solved.Of("plate");
+        // The cones are normalised to give exactly the horizontal irradiance.
+        ExpectWithin(light.irradianceUpperWm2, 300.0, light.stderrUpperWm2);
+    }
+}
+
+// An emitter of exitance M and a black receiver of equal area: E_receiver = M · F.
+struct ViewFactorCase {
+    const char* name;
+    std::shared_ptr<const Mesh> emitter, receiver;
+    double viewFactorTimesAreaRatio;
+    double geometryError;  // relative, from approximating the closed form's shapes
+};
+
+class ViewFactor : public ::testing::TestWithParam<int> {};
+
+std::vector<ViewFactorCase> ViewFactorCases() {
+    const auto rect = [](double w, double h, double z, bool down) {
+        const glm::dvec3 a(0, 0, z), b(w, 0, z), c(w, h, z), d(0, h, z);
+        return down ? Quad(a, d, c, b) : Quad(a, b, c, d);
+    };
+    // Perpendicular: emitter in z = 0 (1 × w1, upper side +z), receiver in y = 0 (1 × w2).
+    const auto perpendicular = [](double w1, double w2) {
+        return std::make_pair(Quad({0, 0, 0}, {1, 0, 0}, {1, w1, 0}, {0, w1, 0}),
+                              Quad({0, 0, 0}, {0, 0, w2}, {1, 0, w2}, {1, 0, 0}));
+    };
+    const auto [p1e, p1r] = perpendicular(1, 1);
+    const auto [p2e, p2r] = perpendicular(1, 2);
+    return {
+        {"parallel_unit_gap_1", rect(1, 1, 0, false), rect(1, 1, 1, true), 0.199825, 0},
+        {"parallel_1x2_gap_0.5", rect(1, 2, 0, false), rect(1, 2, 0.5, true), 0.508989, 0},
+        {"parallel_unit_gap_0.1", rect(1, 1, 0, false), rect(1, 1, 0.1, true), 0.826995, 0},
+        {"parallel_unit_gap_10", rect(1, 1, 0, false), rect(1, 1, 10, true), 0.003162, 1e-3},
+        {"perpendicular_unit", p1e, p1r, 0.200044, 0},
+        // F(1 → 2) = 0.232853 with A1 = 1, A2 = 2: E2 = M · F · A1 / A2.
+        {"perpendicular_1_2", p2e, p2r, 0.232853 / 2.0, 0},
+        {"coaxial_discs_1_1_1", Disc(1, 0, false), Disc(1, 1, true), 0.381966, 1e-4},
+        // F(r 0.2 → r 0.5) = 0.480032: E2 = M · F · (0.2/0.5)².
+        {"coaxial_discs_0.2_0.5", Disc(0.2, 0, false), Disc(0.5, 0.5, true), 0.480032 * 0.16,
+         1e-4},
+    };
+}
+
+TEST_P(ViewFactor, BlackReceiverMatchesHowell) {
+    const ViewFactorCase c = ViewFactorCases()[GetParam()];
+    SCOPED_TRACE(c.name);
+    Scene scene = OneBandScene({{"black", Leaf(0, 0)}});
+    scene.nodes.push_back(OrganNode(1, "receiver", c.receiver, "black"));
+    const double exitance = 1000.0;
+    scene.sources.emitters.push_back({"lamp", c.emitter, {exitance}, ""});
+    const Solved solved = Solve(scene, 65536);
+    const BandLight& light = solved.Of("receiver");
+    // The receiver's upper side faces away from the emitter in every case.
+    const double e = light.irradianceLowerWm2 + light.irradianceUpperWm2;
+    const double error = std::hypot(light.stderrLowerWm2, light.stderrUpperWm2);
+    ExpectWithin(e, exitance * c.viewFactorTimesAreaRatio, error,
+                 // The table's 6 digits, and the shapes' approximation.
+                 exitance * (5e-7 + c.geometryError * c.viewFactorTimesAreaRatio));
+}
+
+INSTANTIATE_TEST_SUITE_P(Howell, ViewFactor, ::testing::Range(0, 8));
+
+// A closed cube whose inner faces emit E and reflect ρ: B = E / (1 − ρ) everywhere, and
+// each face receives B from the others (the form factors of a closed box sum to 1).
+Scene Furnace(double rho, double exitance) {
+    Scene scene = OneBandScene({{"wall", Opaque(rho)}});
+    const glm::dvec3 p[8] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                             {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    // Counter-clockwise seen from inside: upper sides face into the box.
+    const int faces[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1},
+                             {1, 5, 6, 2}, {2, 6, 7, 3}, {3, 7, 4, 0}};
+    for (int f = 0; f < 6; ++f) {
+        scene.sources.emitters.push_back({"face" + std::to_string(f),
+                                          Quad(p[faces[f][0]], p[faces[f][1]], p[faces[f][2]],
+                                               p[faces[f][3]]),
+                                          {exitance}, "wall"});
+    }
+    return scene;
+}
+
+TEST(Furnace, RadiosityIsEmittanceOverOneMinusRho) {
+    for (double rho : {0.5, 0.9}) {
+        SCOPED_TRACE(rho);
+        const double exitance = 10.0;
+        const Solved solved = Solve(Furnace(rho, exitance), 16384);
+        for (int f = 0; f < 6; ++f) {
+            const BandLight& light = solved.Of("face" + std::to_string(f));
+            ExpectWithin(light.irradianceUpperWm2, exitance / (1.0 - rho), light.stderrUpperWm2);
+            // Outside the box is dark, but for rays that leave a face at a shared edge and
+            // graze the next face in float rounding: 1e-30 W/m² and the like.
+            EXPECT_NEAR(light.irradianceLowerWm2, 0.0, 1e-12 * exitance);
+        }
+        // Closed: nothing escapes and all that arrives is absorbed, in expectation.
+        const EnergyBalance& balance = solved.solution.balance[0];
+        EXPECT_NEAR(balance.escapedW, 0.0, 1e-12 * balance.incidentW);
+        EXPECT_NEAR(balance.incidentW - balance.absorbedW, 0.0, kSigmas * balance.stderrW);
+    }
+}
+
+}  // namespace
+}  // namespace leaflux

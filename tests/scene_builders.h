@@ -1,0 +1,74 @@
+// Small scenes with known answers, shared by the tests.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/constants.hpp>
+
+#include "solver/scene.h"
+
+namespace leaflux::testing {
+
+inline constexpr double kPi = glm::pi<double>();
+
+// A planar quad a, b, c, d (counter-clockwise seen from its upper side).
+inline std::shared_ptr<const Mesh> Quad(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) {
+    auto mesh = std::make_shared<Mesh>();
+    mesh->positions = {a, b, c, d};
+    mesh->triangles = {{0, 1, 2}, {0, 2, 3}};
+    return mesh;
+}
+
+// A horizontal w × h rectangle centred on (0, 0, z); upper side up, or down if `facingDown`.
+inline std::shared_ptr<const Mesh> Rectangle(double w, double h, double z, bool facingDown = false) {
+    const glm::dvec3 a(-w / 2, -h / 2, z), b(w / 2, -h / 2, z), c(w / 2, h / 2, z), d(-w / 2, h / 2, z);
+    return facingDown ? Quad(a, d, c, b) : Quad(a, b, c, d);
+}
+
+// A regular polygon approximating a disc of radius r (same area) centred on (0, 0, z).
+inline std::shared_ptr<const Mesh> Disc(double r, double z, bool facingDown, int sides = 256) {
+    auto mesh = std::make_shared<Mesh>();
+    const double step = 2.0 * kPi / sides;
+    const double radius = r * std::sqrt(step / std::sin(step));  // keeps the disc's area
+    mesh->positions.push_back({0, 0, z});
+    for (int i = 0; i < sides; ++i) {
+        mesh->positions.push_back({radius * std::cos(i * step), radius * std::sin(i * step), z});
+    }
+    for (unsigned i = 0; i < static_cast<unsigned>(sides); ++i) {
+        const unsigned a = 1 + i, b = 1 + (i + 1) % sides;
+        mesh->triangles.push_back(facingDown ? glm::uvec3(0, b, a) : glm::uvec3(0, a, b));
+    }
+    return mesh;
+}
+
+inline BandOptics Leaf(double rho, double tau) { return {rho, rho, tau, tau}; }
+inline BandOptics Opaque(double rho) { return {rho, rho, 0.0, 0.0}; }
+
+// A scene with one band "PAR" and the given optics.
+inline Scene OneBandScene(std::vector<std::pair<std::string, BandOptics>> optics) {
+    Scene scene;
+    scene.bands = {{"PAR"}};
+    for (auto& [id, o] : optics) scene.optics.push_back({id, {o}});
+    return scene;
+}
+
+inline Node OrganNode(NodeId id, const std::string& name, std::shared_ptr<const Mesh> mesh,
+                  const std::string& optics, NodeId parent = kNoParent) {
+    Node node;
+    node.id = id;
+    node.parent = parent;
+    node.type = NodeType::kLeaf;
+    node.name = name;
+    node.organ = leaflux::Organ{std::move(mesh), optics};
+    return node;
+}
+
+inline Sun SunAt(double elevationDeg, double azimuthDeg, double irradiance) {
+    const double h = glm::radians(elevationDeg), a = glm::radians(azimuthDeg);
+    return {glm::dvec3(std::cos(h) * std::sin(a), std::cos(h) * std::cos(a), std::sin(h)),
+            {irradiance}, 0.0};
+}
+
+}  // namespace leaflux::testing
