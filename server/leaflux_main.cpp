@@ -1,0 +1,157 @@
+// leaflux: the one-shot command line. `solve` lights a scene file, `generate` writes a
+// procedural tree or plantation as a scene file.
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include "server/scene_proto.h"
+#include "solver/error.h"
+#include "solver/export.h"
+#include "solver/generator.h"
+#include "solver/solve.h"
+
+namespace leaflux {
+namespace {
+
+struct SolveCommand {
+    std::string scene, solver = "mc", out, structures;
+    int samples = 1024, replicates = 16, threads = 0;
+    std::uint64_t seed = 1;
+    bool quiet = false;
+};
+
+int RunSolve(const SolveCommand& command) {
+    const auto start = std::chrono::steady_clock::now();
+    const Scene scene = LoadSceneFile(command.scene);
+    PreparedScene prepared(scene);
+    SolverSettings settings;
+    settings.monteCarlo.samplesPerReceiver = command.samples;
+    settings.monteCarlo.replicates = command.replicates;
+    settings.monteCarlo.seed = command.seed;
+    settings.monteCarlo.threads = command.threads;
+    if (!command.quiet) {
+        spdlog::info("{}: {} receivers, {} triangles, {} bands; loaded in {:.2f} s", command.scene,
+                     prepared.Flat().receivers.size(), prepared.Flat().triangles.size(),
+                     scene.bands.size(),
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        settings.monteCarlo.progress = [last = -1](double done) mutable {
+            const int tenth = static_cast<int>(done * 10.0);
+            if (tenth > last) {
+                last = tenth;
+                std::fprintf(stderr, "\r  %3d %%", 10 * tenth);
+                if (tenth == 10) std::fprintf(stderr, "\n");
+            }
+        };
+    }
+    const Solution solution = Solve(prepared, settings);
+    std::ofstream leaves(command.out);
+    if (!leaves) throw InputError(ErrorCode::kIo, command.out, "cannot write");
+    WriteLeafCsv(leaves, scene, prepared.Flat(), solution);
+    if (!command.structures.empty()) {
+        std::ofstream structures(command.structures);
+        if (!structures) throw InputError(ErrorCode::kIo, command.structures, "cannot write");
+        WriteStructureCsv(structures, scene, AggregateStructures(scene, prepared.Flat(), solution));
+    }
+    std::cout << Summary(command.solver, scene, prepared.Flat(), solution) << std::endl;
+    return 0;
+}
+
+struct GenerateCommand {
+    TreeParameters tree;
+    int rows = 1, columns = 1;
+    double spacing = 6.0, rowAzimuth = 0.0, sunElevation = 50.0, sunAzimuth = 160.0;
+    double sunPar = 400.0, sunNir = 350.0, skyPar = 100.0, skyNir = 60.0;
+    bool noSky = false;
+    std::string out;
+};
+
+// PAR- and NIR-like optics (leaf ρ, τ), a sun and a CIE overcast sky: a scene ready to solve.
+int RunGenerate(const GenerateCommand& command) {
+    Scene scene;
+    scene.bands = {{"PAR", 400, 700}, {"NIR", 700, 2500}};
+    scene.optics = {{"leaf", {{0.10, 0.10, 0.05, 0.05}, {0.45, 0.45, 0.45, 0.45}}},
+                    {"stem", {{0.10, 0.10, 0.0, 0.0}, {0.40, 0.40, 0.0, 0.0}}},
+                    {"ground", {{0.10, 0.10, 0.0, 0.0}, {0.30, 0.30, 0.0, 0.0}}}};
+    PlantationParameters plantation;
+    plantation.tree = command.tree;
+    plantation.rows = command.rows;
+    plantation.columns = command.columns;
+    plantation.rowSpacingM = plantation.columnSpacingM = command.spacing;
+    plantation.rowAzimuthDeg = command.rowAzimuth;
+    plantation.jitterM = 0.1 * command.spacing;
+    AddPlantation(scene, plantation, "ground");
+    const double h = glm::radians(command.sunElevation), a = glm::radians(command.sunAzimuth);
+    scene.sources.suns.push_back(
+        {{std::cos(h) * std::sin(a), std::cos(h) * std::cos(a), std::sin(h)},
+         {command.sunPar, command.sunNir}, 0.0});
+    if (!command.noSky) {
+        scene.sources.skies.push_back(
+            {SkyModel::kCieOvercast, {command.skyPar, command.skyNir}, SkyDiscretization::kContinuous});
+    }
+    scene.Validate();
+    SaveSceneFile(scene, command.out);
+    std::size_t leaves = 0;
+    for (const Node& node : scene.nodes) leaves += node.type == NodeType::kLeaf;
+    std::cout << "wrote " << command.out << ": " << leaves << " leaves, " << scene.nodes.size()
+              << " nodes" << std::endl;
+    return 0;
+}
+
+}  // namespace
+}  // namespace leaflux
+
+int main(int argc, char** argv) {
+    using namespace leaflux;
+    CLI::App app{"leaflux: light on plants by hierarchical radiosity, with a Monte Carlo reference"};
+    app.require_subcommand(1);
+
+    SolveCommand solve;
+    CLI::App* solveApp = app.add_subcommand("solve", "Light a scene file and write per-organ results");
+    solveApp->add_option("--scene", solve.scene, "Scene file (protobuf text format, leaflux.v1.Scene)")
+        ->required()->check(CLI::ExistingFile);
+    solveApp->add_option("--solver", solve.solver, "Solver: mc (Monte Carlo reference)")
+        ->check(CLI::IsMember({"mc"}));
+    solveApp->add_option("--samples", solve.samples, "mc: paths per receiver (standard error ~ 1/sqrt)")
+        ->check(CLI::Range(2, 1 << 26));
+    solveApp->add_option("--replicates", solve.replicates, "mc: independent groups for the standard error")
+        ->check(CLI::Range(2, 1024));
+    solveApp->add_option("--seed", solve.seed, "mc: random seed (same seed, same result)");
+    solveApp->add_option("--threads", solve.threads, "Worker threads (0: every core)")->check(CLI::Range(0, 1024));
+    solveApp->add_option("--out", solve.out, "Per-organ CSV: organ,band,area_m2,irradiance_upper_wm2,"
+                                             "irradiance_lower_wm2,absorbed_w,light_x,light_y,light_z,"
+                                             "stderr_upper_wm2,stderr_lower_wm2")->required();
+    solveApp->add_option("--structures", solve.structures, "Per-structure CSV (plants, axes, phytomers)");
+    solveApp->add_flag("--quiet", solve.quiet, "No progress or log lines, only the summary");
+
+    GenerateCommand generate;
+    CLI::App* generateApp = app.add_subcommand("generate", "Write a procedural poplar-like tree or plantation");
+    generateApp->add_option("--leaves", generate.tree.leafCount, "Leaves per tree")->check(CLI::Range(1, 10'000'000));
+    generateApp->add_option("--seed", generate.tree.seed, "Random seed");
+    generateApp->add_option("--leaf-length", generate.tree.leafLengthM, "Mean leaf length (m)")->check(CLI::PositiveNumber);
+    generateApp->add_option("--rows", generate.rows, "Rows of trees")->check(CLI::Range(1, 1000));
+    generateApp->add_option("--columns", generate.columns, "Trees per row")->check(CLI::Range(1, 1000));
+    generateApp->add_option("--spacing", generate.spacing, "Distance between trees (m)")->check(CLI::PositiveNumber);
+    generateApp->add_option("--row-azimuth", generate.rowAzimuth, "Row direction from north, clockwise (deg)");
+    generateApp->add_option("--sun-elevation", generate.sunElevation, "Sun elevation (deg)")->check(CLI::Range(0.0, 90.0));
+    generateApp->add_option("--sun-azimuth", generate.sunAzimuth, "Sun azimuth from north, clockwise (deg)");
+    generateApp->add_flag("--no-sky", generate.noSky, "Sun only, no diffuse sky");
+    generateApp->add_flag("!--internodes", generate.tree.internodes, "No internode geometry (leaves only)");
+    generateApp->add_option("--out", generate.out, "Scene file to write")->required();
+
+    CLI11_PARSE(app, argc, argv);
+    try {
+        if (solveApp->parsed()) return RunSolve(solve);
+        if (generateApp->parsed()) return RunGenerate(generate);
+    } catch (const InputError& e) {
+        spdlog::error("{}", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        spdlog::error("internal error: {}", e.what());
+        return 3;
+    }
+    return 1;
+}

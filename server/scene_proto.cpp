@@ -1,0 +1,405 @@
+#include "server/scene_proto.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <google/protobuf/io/tokenizer.h>
+#include <google/protobuf/text_format.h>
+
+#include "solver/error.h"
+#include "solver/importers.h"
+
+namespace leaflux {
+namespace {
+
+[[noreturn]] void Fail(ErrorCode code, const std::string& field, const std::string& message,
+                       std::optional<NodeId> node = std::nullopt) {
+    throw InputError(code, field, message, node);
+}
+
+// A band → value map as a vector in scene band order; every band must be present.
+std::vector<double> PerBand(const Scene& scene,
+                            const google::protobuf::Map<std::string, double>& values,
+                            const std::string& field) {
+    std::vector<double> result(scene.bands.size(), 0.0);
+    std::vector<bool> seen(scene.bands.size(), false);
+    for (const auto& [band, value] : values) {
+        const int b = scene.BandIndex(band);
+        if (b < 0) Fail(ErrorCode::kNotFound, field + "[" + band + "]", "names no declared band");
+        result[b] = value;
+        seen[b] = true;
+    }
+    for (std::size_t b = 0; b < seen.size(); ++b) {
+        if (!seen[b]) Fail(ErrorCode::kNotFound, field, "has no value for band " + scene.bands[b].name);
+    }
+    return result;
+}
+
+glm::dmat4 FrameFromProto(const v1::Frame& frame, const std::string& field,
+                          std::optional<NodeId> node = std::nullopt) {
+    if (frame.m_size() == 0) return glm::dmat4(1.0);
+    if (frame.m_size() != 12) {
+        Fail(ErrorCode::kInvalidArgument, field, "needs 12 numbers (3×4 row-major), got " +
+                                                     std::to_string(frame.m_size()), node);
+    }
+    glm::dmat4 m(1.0);
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 4; ++c) m[c][r] = frame.m(4 * r + c);
+    }
+    return m;
+}
+
+void FrameToProto(const glm::dmat4& m, v1::Frame* frame) {
+    if (m == glm::dmat4(1.0)) return;
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 4; ++c) frame->add_m(m[c][r]);
+    }
+}
+
+std::shared_ptr<const Mesh> MeshFromProto(const v1::Mesh& message, const std::string& field,
+                                          std::optional<NodeId> node = std::nullopt) {
+    if (message.positions_size() % 3 != 0) {
+        Fail(ErrorCode::kInvalidArgument, field + ".positions", "is not x, y, z triples", node);
+    }
+    if (message.triangles_size() % 3 != 0) {
+        Fail(ErrorCode::kInvalidArgument, field + ".triangles", "is not index triples", node);
+    }
+    auto mesh = std::make_shared<Mesh>();
+    for (int i = 0; i < message.positions_size(); i += 3) {
+        mesh->positions.push_back(
+            {message.positions(i), message.positions(i + 1), message.positions(i + 2)});
+    }
+    for (int i = 0; i < message.triangles_size(); i += 3) {
+        mesh->triangles.push_back(
+            {message.triangles(i), message.triangles(i + 1), message.triangles(i + 2)});
+    }
+    return mesh;
+}
+
+void MeshToProto(const Mesh& mesh, v1::Mesh* message) {
+    for (const glm::dvec3& p : mesh.positions) {
+        message->add_positions(p.x);
+        message->add_positions(p.y);
+        message->add_positions(p.z);
+    }
+    for (const glm::uvec3& t : mesh.triangles) {
+        message->add_triangles(t.x);
+        message->add_triangles(t.y);
+        message->add_triangles(t.z);
+    }
+}
+
+NodeType TypeFromProto(v1::NodeType type) {
+    switch (type) {
+        case v1::NODE_TYPE_PLANT: return NodeType::kPlant;
+        case v1::NODE_TYPE_AXIS: return NodeType::kAxis;
+        case v1::NODE_TYPE_PHYTOMER: return NodeType::kPhytomer;
+        case v1::NODE_TYPE_LEAF: return NodeType::kLeaf;
+        case v1::NODE_TYPE_INTERNODE: return NodeType::kInternode;
+        case v1::NODE_TYPE_FRUIT: return NodeType::kFruit;
+        default: return NodeType::kOther;
+    }
+}
+
+v1::NodeType TypeToProto(NodeType type) {
+    switch (type) {
+        case NodeType::kPlant: return v1::NODE_TYPE_PLANT;
+        case NodeType::kAxis: return v1::NODE_TYPE_AXIS;
+        case NodeType::kPhytomer: return v1::NODE_TYPE_PHYTOMER;
+        case NodeType::kLeaf: return v1::NODE_TYPE_LEAF;
+        case NodeType::kInternode: return v1::NODE_TYPE_INTERNODE;
+        case NodeType::kFruit: return v1::NODE_TYPE_FRUIT;
+        case NodeType::kOther: return v1::NODE_TYPE_OTHER;
+    }
+    return v1::NODE_TYPE_OTHER;
+}
+
+SkyDiscretization DiscretizationFromProto(v1::SkyDiscretization d) {
+    switch (d) {
+        case v1::SKY_DISCRETIZATION_TURTLE_46: return SkyDiscretization::kTurtle46;
+        case v1::SKY_DISCRETIZATION_TETRA_34: return SkyDiscretization::kTetra34;
+        case v1::SKY_DISCRETIZATION_TETRA_130: return SkyDiscretization::kTetra130;
+        case v1::SKY_DISCRETIZATION_TETRA_514: return SkyDiscretization::kTetra514;
+        default: return SkyDiscretization::kContinuous;
+    }
+}
+
+v1::SkyDiscretization DiscretizationToProto(SkyDiscretization d) {
+    switch (d) {
+        case SkyDiscretization::kTurtle46: return v1::SKY_DISCRETIZATION_TURTLE_46;
+        case SkyDiscretization::kTetra34: return v1::SKY_DISCRETIZATION_TETRA_34;
+        case SkyDiscretization::kTetra130: return v1::SKY_DISCRETIZATION_TETRA_130;
+        case SkyDiscretization::kTetra514: return v1::SKY_DISCRETIZATION_TETRA_514;
+        case SkyDiscretization::kContinuous: return v1::SKY_DISCRETIZATION_CONTINUOUS;
+    }
+    return v1::SKY_DISCRETIZATION_CONTINUOUS;
+}
+
+void ReadSources(const v1::Scene& message, Scene& scene, const std::filesystem::path& base) {
+    for (int i = 0; i < message.suns_size(); ++i) {
+        const v1::Sun& in = message.suns(i);
+        const std::string field = "suns[" + std::to_string(i) + "]";
+        Sun sun;
+        if (in.has_solar()) {
+            const v1::SolarPosition& p = in.solar();
+            if (!std::isfinite(p.latitude_deg()) || std::abs(p.latitude_deg()) > 90.0) {
+                Fail(ErrorCode::kInvalidArgument, field + ".solar.latitude_deg", "must be in [-90, 90]");
+            }
+            if (p.day_of_year() < 1 || p.day_of_year() > 366) {
+                Fail(ErrorCode::kInvalidArgument, field + ".solar.day_of_year", "must be in [1, 366]");
+            }
+            if (!std::isfinite(p.solar_time_h()) || p.solar_time_h() < 0.0 || p.solar_time_h() > 24.0) {
+                Fail(ErrorCode::kInvalidArgument, field + ".solar.solar_time_h", "must be in [0, 24]");
+            }
+            sun.towardSun = DirectionFromAngles(SolarPosition(p.latitude_deg(), p.day_of_year(), p.solar_time_h()));
+        } else {
+            const glm::dvec3 d(in.direction().x(), in.direction().y(), in.direction().z());
+            const double length = glm::length(d);
+            if (!std::isfinite(length) || length == 0.0) {
+                Fail(ErrorCode::kInvalidArgument, field + ".direction", "must be a finite non-zero vector");
+            }
+            sun.towardSun = d / length;
+        }
+        sun.normalIrradianceWm2 = PerBand(scene, in.normal_irradiance(), field + ".normal_irradiance");
+        sun.angularRadiusRad = glm::radians(in.angular_radius_deg());
+        scene.sources.suns.push_back(std::move(sun));
+    }
+    for (int i = 0; i < message.sun_periods_size(); ++i) {
+        const v1::SunPeriod& p = message.sun_periods(i);
+        const std::string field = "sun_periods[" + std::to_string(i) + "]";
+        if (!(p.step_h() > 0.0) || !(p.end_h() > p.start_h()) || p.start_h() < 0.0 || p.end_h() > 24.0) {
+            Fail(ErrorCode::kInvalidArgument, field, "needs 0 <= start_h < end_h <= 24 and step_h > 0");
+        }
+        if (p.day_of_year() < 1 || p.day_of_year() > 366 || std::abs(p.latitude_deg()) > 90.0) {
+            Fail(ErrorCode::kInvalidArgument, field, "needs a day of year in [1, 366] and a latitude in [-90, 90]");
+        }
+        const auto suns = SunPositionsOverPeriod(p.latitude_deg(), p.day_of_year(), p.start_h(), p.end_h(),
+                                                 p.step_h(), PerBand(scene, p.normal_irradiance(), field + ".normal_irradiance"));
+        scene.sources.suns.insert(scene.sources.suns.end(), suns.begin(), suns.end());
+    }
+    if (message.has_sky()) {
+        Sky sky;
+        sky.model = message.sky().model() == v1::SKY_MODEL_CIE_OVERCAST ? SkyModel::kCieOvercast : SkyModel::kUniform;
+        sky.horizontalIrradianceWm2 = PerBand(scene, message.sky().horizontal_irradiance(), "sky.horizontal_irradiance");
+        sky.discretization = DiscretizationFromProto(message.sky().discretization());
+        scene.sources.skies.push_back(std::move(sky));
+    }
+    for (int i = 0; i < message.emitters_size(); ++i) {
+        const v1::Emitter& in = message.emitters(i);
+        const std::string field = "emitters[" + (in.name().empty() ? std::to_string(i) : in.name()) + "]";
+        scene.sources.emitters.push_back({in.name(), MeshFromProto(in.mesh(), field + ".mesh"),
+                                          PerBand(scene, in.exitance(), field + ".exitance"), in.optics()});
+    }
+    for (int i = 0; i < message.can_lights_size(); ++i) {
+        const v1::CanLights& in = message.can_lights(i);
+        const std::string field = "can_lights[" + std::to_string(i) + "]";
+        const std::vector<double> scale = PerBand(scene, in.scale(), field + ".scale");
+        for (const CanLight& light : ReadCanLights((base / in.path()).string())) {
+            if (light.towardSource.z <= 0.0) continue;  // below the horizon: lights nothing from the sky
+            Sun sun;
+            sun.towardSun = light.towardSource;
+            for (double s : scale) sun.normalIrradianceWm2.push_back(s * light.horizontalIrradiance / light.towardSource.z);
+            scene.sources.suns.push_back(std::move(sun));
+        }
+    }
+}
+
+}  // namespace
+
+// Imports are in scene_import.cpp.
+void ReadImports(const v1::Scene& message, Scene& scene, const std::filesystem::path& base);
+
+Scene FromProto(const v1::Scene& message, const std::string& baseDirectory) {
+    if (message.version() > v1::PROTOCOL_VERSION_CURRENT) {
+        Fail(ErrorCode::kUnsupported, "version", "is newer than this leaflux understands");
+    }
+    const std::filesystem::path base(baseDirectory);
+    Scene scene;
+    for (const v1::Band& band : message.bands()) {
+        scene.bands.push_back({band.name(), band.wavelength_min_nm(), band.wavelength_max_nm()});
+    }
+    for (const v1::Optics& optics : message.optics()) {
+        Optics o;
+        o.id = optics.id();
+        o.bands.resize(scene.bands.size());
+        const std::string field = "optics[" + optics.id() + "]";
+        std::vector<bool> seen(scene.bands.size(), false);
+        for (const auto& [band, values] : optics.bands()) {
+            const int b = scene.BandIndex(band);
+            if (b < 0) Fail(ErrorCode::kNotFound, field + ".bands[" + band + "]", "names no declared band");
+            o.bands[b] = {values.rho_upper(), values.rho_lower(), values.tau_upper(), values.tau_lower()};
+            seen[b] = true;
+        }
+        for (std::size_t b = 0; b < seen.size(); ++b) {
+            if (!seen[b]) Fail(ErrorCode::kNotFound, field + ".bands", "has no properties for band " + scene.bands[b].name);
+        }
+        scene.optics.push_back(std::move(o));
+    }
+    std::map<std::string, std::shared_ptr<const Mesh>> meshes;
+    for (const auto& [name, mesh] : message.meshes()) meshes[name] = MeshFromProto(mesh, "meshes[" + name + "]");
+    for (const v1::Node& in : message.nodes()) {
+        Node node;
+        node.id = in.id();
+        node.parent = in.parent();
+        node.type = TypeFromProto(in.type());
+        node.name = in.name();
+        node.parentFromLocal = FrameFromProto(in.frame(), "frame", in.id());
+        node.age = in.age();
+        node.attributes.insert(in.attributes().begin(), in.attributes().end());
+        if (in.has_organ()) {
+            const v1::Organ& organ = in.organ();
+            std::shared_ptr<const Mesh> mesh;
+            if (organ.has_mesh_ref()) {
+                const auto it = meshes.find(organ.mesh_ref());
+                if (it == meshes.end()) Fail(ErrorCode::kNotFound, "organ.mesh_ref", "names no mesh '" + organ.mesh_ref() + "'", in.id());
+                mesh = it->second;
+            } else {
+                mesh = MeshFromProto(organ.mesh(), "organ.mesh", in.id());
+            }
+            node.organ = Organ{mesh, organ.optics()};
+        }
+        scene.nodes.push_back(std::move(node));
+    }
+    for (const v1::Surface& surface : message.environment()) {
+        scene.environment.push_back({surface.name(), MeshFromProto(surface.mesh(), "environment[" + surface.name() + "].mesh"),
+                                     surface.optics()});
+    }
+    ReadSources(message, scene, base);
+    if (message.has_periodic()) {
+        const v1::PeriodicDomain& p = message.periodic();
+        scene.periodic = PeriodicDomain{p.x_min(), p.y_min(), p.x_max(), p.y_max()};
+    }
+    ReadImports(message, scene, base);
+    scene.Validate();
+    return scene;
+}
+
+v1::Scene ToProto(const Scene& scene) {
+    v1::Scene message;
+    message.set_version(v1::PROTOCOL_VERSION_CURRENT);
+    for (const Band& band : scene.bands) {
+        v1::Band* b = message.add_bands();
+        b->set_name(band.name);
+        b->set_wavelength_min_nm(band.wavelengthMinNm);
+        b->set_wavelength_max_nm(band.wavelengthMaxNm);
+    }
+    for (const Optics& optics : scene.optics) {
+        v1::Optics* o = message.add_optics();
+        o->set_id(optics.id);
+        for (std::size_t b = 0; b < optics.bands.size(); ++b) {
+            v1::BandOptics& values = (*o->mutable_bands())[scene.bands[b].name];
+            values.set_rho_upper(optics.bands[b].rhoUpper);
+            values.set_rho_lower(optics.bands[b].rhoLower);
+            values.set_tau_upper(optics.bands[b].tauUpperToLower);
+            values.set_tau_lower(optics.bands[b].tauLowerToUpper);
+        }
+    }
+    // A mesh used by more than one organ is written once and referenced.
+    std::map<const Mesh*, int> uses;
+    for (const Node& node : scene.nodes) {
+        if (node.organ) ++uses[node.organ->mesh.get()];
+    }
+    std::map<const Mesh*, std::string> names;
+    for (const Node& node : scene.nodes) {
+        v1::Node* n = message.add_nodes();
+        n->set_id(node.id);
+        n->set_parent(node.parent);
+        n->set_type(TypeToProto(node.type));
+        n->set_name(node.name);
+        FrameToProto(node.parentFromLocal, n->mutable_frame());
+        n->set_age(node.age);
+        n->mutable_attributes()->insert(node.attributes.begin(), node.attributes.end());
+        if (!node.organ) continue;
+        v1::Organ* organ = n->mutable_organ();
+        organ->set_optics(node.organ->opticsId);
+        const Mesh* mesh = node.organ->mesh.get();
+        if (uses[mesh] == 1) {
+            MeshToProto(*mesh, organ->mutable_mesh());
+            continue;
+        }
+        auto [it, added] = names.emplace(mesh, "mesh" + std::to_string(names.size()));
+        if (added) MeshToProto(*mesh, &(*message.mutable_meshes())[it->second]);
+        organ->set_mesh_ref(it->second);
+    }
+    for (const Surface& surface : scene.environment) {
+        v1::Surface* s = message.add_environment();
+        s->set_name(surface.name);
+        s->set_optics(surface.opticsId);
+        MeshToProto(*surface.mesh, s->mutable_mesh());
+    }
+    auto perBand = [&](const std::vector<double>& values, google::protobuf::Map<std::string, double>* map) {
+        for (std::size_t b = 0; b < values.size(); ++b) (*map)[scene.bands[b].name] = values[b];
+    };
+    for (const Sun& sun : scene.sources.suns) {
+        v1::Sun* s = message.add_suns();
+        s->mutable_direction()->set_x(sun.towardSun.x);
+        s->mutable_direction()->set_y(sun.towardSun.y);
+        s->mutable_direction()->set_z(sun.towardSun.z);
+        perBand(sun.normalIrradianceWm2, s->mutable_normal_irradiance());
+        s->set_angular_radius_deg(glm::degrees(sun.angularRadiusRad));
+    }
+    if (!scene.sources.skies.empty()) {
+        const Sky& sky = scene.sources.skies.front();
+        v1::Sky* s = message.mutable_sky();
+        s->set_model(sky.model == SkyModel::kCieOvercast ? v1::SKY_MODEL_CIE_OVERCAST : v1::SKY_MODEL_UNIFORM);
+        perBand(sky.horizontalIrradianceWm2, s->mutable_horizontal_irradiance());
+        s->set_discretization(DiscretizationToProto(sky.discretization));
+    }
+    for (const Emitter& emitter : scene.sources.emitters) {
+        v1::Emitter* e = message.add_emitters();
+        e->set_name(emitter.name);
+        e->set_optics(emitter.opticsId);
+        MeshToProto(*emitter.mesh, e->mutable_mesh());
+        perBand(emitter.exitanceWm2, e->mutable_exitance());
+    }
+    if (scene.periodic) {
+        v1::PeriodicDomain* p = message.mutable_periodic();
+        p->set_x_min(scene.periodic->xMin);
+        p->set_y_min(scene.periodic->yMin);
+        p->set_x_max(scene.periodic->xMax);
+        p->set_y_max(scene.periodic->yMax);
+    }
+    return message;
+}
+
+namespace {
+class CollectErrors : public google::protobuf::io::ErrorCollector {
+public:
+    void AddError(int line, google::protobuf::io::ColumnNumber column, const std::string& message) override {
+        if (first_.empty()) first_ = std::to_string(line + 1) + ":" + std::to_string(column + 1) + ": " + message;
+    }
+    const std::string& First() const { return first_; }
+
+private:
+    std::string first_;
+};
+}  // namespace
+
+Scene LoadSceneFile(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) Fail(ErrorCode::kIo, path, "cannot open the scene file");
+    std::stringstream text;
+    text << in.rdbuf();
+    v1::Scene message;
+    google::protobuf::TextFormat::Parser parser;
+    CollectErrors errors;
+    parser.RecordErrorsTo(&errors);
+    if (!parser.ParseFromString(text.str(), &message)) {
+        const std::string& first = errors.First();
+        const auto colon = first.find(": ");
+        Fail(ErrorCode::kParse, path + ":" + first.substr(0, colon), colon == std::string::npos ? first : first.substr(colon + 2));
+    }
+    return FromProto(message, std::filesystem::path(path).parent_path().string());
+}
+
+void SaveSceneFile(const Scene& scene, const std::string& path) {
+    std::string text;
+    google::protobuf::TextFormat::PrintToString(ToProto(scene), &text);
+    std::ofstream out(path);
+    if (!out || !(out << text)) Fail(ErrorCode::kIo, path, "cannot write the scene file");
+}
+
+}  // namespace leaflux

@@ -1,0 +1,25 @@
+// Conversion between the wire/file schema (leaflux.v1.Scene) and the solver's Scene.
+//
+// FromProto checks what only the schema can get wrong (an unknown band name in a map, a
+// frame of 7 numbers, a dangling mesh_ref, a file that cannot be imported) and then runs
+// Scene::Validate: a Scene it returns is valid. Errors are InputError naming the field.
+#pragma once
+
+#include <string>
+
+#include "leaflux.pb.h"
+#include "solver/scene.h"
+
+namespace leaflux {
+
+// `baseDirectory` resolves relative import paths (the scene file's folder).
+Scene FromProto(const v1::Scene& message, const std::string& baseDirectory);
+
+// Shared meshes stay shared: each distinct mesh is written once in `meshes`.
+v1::Scene ToProto(const Scene& scene);
+
+// Reads a scene file in protobuf text format; parse errors name line and column.
+Scene LoadSceneFile(const std::string& path);
+void SaveSceneFile(const Scene& scene, const std::string& path);
+
+}  // namespace leaflux

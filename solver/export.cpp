@@ -1,0 +1,87 @@
+#include "solver/export.h"
+
+#include <cstdio>
+#include <sstream>
+
+namespace leaflux {
+namespace {
+
+// Shortest text that reads back to the same double.
+std::string Number(double value) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.9g", value);
+    return buffer;
+}
+
+std::string Quoted(const std::string& text) {
+    if (text.find_first_of(",\"\n") == std::string::npos) return text;
+    std::string quoted = "\"";
+    for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return quoted + "\"";
+}
+
+void WriteLight(std::ostream& out, const BandLight& light) {
+    const glm::dvec3 v = light.LightVector();
+    out << Number(light.irradianceUpperWm2) << ',' << Number(light.irradianceLowerWm2) << ','
+        << Number(light.absorbedW) << ',' << Number(v.x) << ',' << Number(v.y) << ','
+        << Number(v.z) << ',';
+    if (light.stderrUpperWm2 >= 0.0) {
+        out << Number(light.stderrUpperWm2) << ',' << Number(light.stderrLowerWm2);
+    } else {
+        out << ',';
+    }
+    out << '\n';
+}
+
+constexpr const char* kLightColumns =
+    "irradiance_upper_wm2,irradiance_lower_wm2,absorbed_w,light_x,light_y,light_z,"
+    "stderr_upper_wm2,stderr_lower_wm2\n";
+
+}  // namespace
+
+void WriteLeafCsv(std::ostream& out, const Scene& scene, const FlatScene& flat,
+                  const Solution& solution) {
+    out << "organ,band,area_m2," << kLightColumns;
+    for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
+        for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+            out << Quoted(flat.receivers[r].name) << ',' << Quoted(scene.bands[b].name) << ','
+                << Number(flat.receivers[r].areaM2) << ',';
+            WriteLight(out, solution.light[r][b]);
+        }
+    }
+}
+
+void WriteStructureCsv(std::ostream& out, const Scene& scene,
+                       const std::vector<StructureLight>& structures) {
+    out << "node,name,type,organs,band,area_m2," << kLightColumns;
+    for (const StructureLight& s : structures) {
+        for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+            out << s.node << ',' << Quoted(s.name) << ',' << NodeTypeName(s.type) << ','
+                << s.organCount << ',' << Quoted(scene.bands[b].name) << ',' << Number(s.areaM2)
+                << ',';
+            WriteLight(out, s.bands[b]);
+        }
+    }
+}
+
+std::string Summary(const std::string& solver, const Scene& scene, const FlatScene& flat,
+                    const Solution& solution) {
+    std::ostringstream text;
+    const SolveStats& stats = solution.stats;
+    text << solver << ": " << flat.receivers.size() << " receivers x " << scene.bands.size()
+         << " bands in " << Number(stats.wallSeconds) << " s (cpu " << Number(stats.cpuSeconds)
+         << " s, " << stats.threads << " threads), peak " << stats.peakRssBytes / (1 << 20)
+         << " MiB, " << stats.rays << " rays";
+    for (std::size_t b = 0; b < solution.balance.size(); ++b) {
+        const EnergyBalance& e = solution.balance[b];
+        text << "; " << scene.bands[b].name << ": incident " << Number(e.incidentW)
+             << " W, absorbed " << Number(e.absorbedW) << " W, escaped " << Number(e.escapedW)
+             << " W, residual " << Number(100.0 * e.RelativeResidual()) << " %";
+        if (e.stderrW >= 0.0 && e.incidentW > 0.0) {
+            text << " +- " << Number(100.0 * e.stderrW / e.incidentW) << " %";
+        }
+    }
+    return text.str();
+}
+
+}  // namespace leaflux

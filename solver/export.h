@@ -1,0 +1,28 @@
+// Writers of solver results: the per-organ CSV every solver shares, the per-structure CSV
+// and the one-line summary.
+#pragma once
+
+#include <ostream>
+#include <string>
+
+#include "solver/light.h"
+
+namespace leaflux {
+
+// One row per receiver and band, columns:
+// organ,band,area_m2,irradiance_upper_wm2,irradiance_lower_wm2,absorbed_w,
+// light_x,light_y,light_z,stderr_upper_wm2,stderr_lower_wm2
+// (stderr columns empty when the solver gives none).
+void WriteLeafCsv(std::ostream& out, const Scene& scene, const FlatScene& flat,
+                  const Solution& solution);
+
+// One row per structure and band: node,name,type,organs,area_m2, then as above.
+void WriteStructureCsv(std::ostream& out, const Scene& scene,
+                       const std::vector<StructureLight>& structures);
+
+// "<solver>: <receivers> receivers × <bands> bands in <t> s (cpu <c> s), peak <m> MiB,
+//  <rays> rays; <band>: incident … W, absorbed … W, escaped … W, residual …%".
+std::string Summary(const std::string& solver, const Scene& scene, const FlatScene& flat,
+                    const Solution& solution);
+
+}  // namespace leaflux

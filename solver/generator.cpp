@@ -1,0 +1,239 @@
+#include "solver/generator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "solver/check.h"
+#include "solver/error.h"
+#include "solver/sampling.h"
+
+namespace leaflux {
+namespace {
+
+constexpr double kGoldenAngleDeg = 137.5;
+
+glm::dmat4 FrameOf(const glm::dvec3& origin, const glm::dvec3& x, const glm::dvec3& y,
+                   const glm::dvec3& z) {
+    glm::dmat4 m(1.0);
+    m[0] = glm::dvec4(x, 0.0);
+    m[1] = glm::dvec4(y, 0.0);
+    m[2] = glm::dvec4(z, 0.0);
+    m[3] = glm::dvec4(origin, 1.0);
+    return m;
+}
+
+glm::dvec3 AnyPerpendicular(const glm::dvec3& a) {
+    return glm::normalize(glm::cross(a, std::abs(a.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0)));
+}
+
+// `v` turned by `angle` around the unit axis `k` (Rodrigues).
+glm::dvec3 Rotate(const glm::dvec3& v, const glm::dvec3& k, double angle) {
+    return v * std::cos(angle) + glm::cross(k, v) * std::sin(angle) +
+           k * glm::dot(k, v) * (1.0 - std::cos(angle));
+}
+
+std::shared_ptr<const Mesh> LeafPrototype() {
+    // A blade along local x from the petiole (0) to the tip (1), of width 1 across y.
+    auto mesh = std::make_shared<Mesh>();
+    mesh->positions = {{0, 0, 0}, {0.3, -0.5, 0}, {0.7, -0.5, 0}, {1, 0, 0}, {0.7, 0.5, 0}, {0.3, 0.5, 0}};
+    mesh->triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 5}};
+    return mesh;
+}
+
+std::shared_ptr<const Mesh> InternodePrototype() {
+    // A square prism of unit side around local z, from z = 0 to 1, faces outwards.
+    auto mesh = std::make_shared<Mesh>();
+    const double h = 0.5;
+    mesh->positions = {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0},
+                       {-h, -h, 1}, {h, -h, 1}, {h, h, 1}, {-h, h, 1}};
+    for (unsigned i = 0; i < 4; ++i) {
+        const unsigned j = (i + 1) % 4;
+        mesh->triangles.push_back({i, j, j + 4});
+        mesh->triangles.push_back({i, j + 4, i + 4});
+    }
+    return mesh;
+}
+
+class TreeBuilder {
+public:
+    TreeBuilder(Scene& scene, const TreeParameters& p, NodeId firstId)
+        : scene_(scene), p_(p), next_(firstId), leaf_(LeafPrototype()), internode_(InternodePrototype()) {
+        const int shoots = (p.leafCount + p.leavesPerShoot - 1) / p.leavesPerShoot;
+        depth_ = 0;
+        while (std::pow(p.maxBranching, depth_) < shoots) ++depth_;
+        branching_ = depth_ == 0 ? 1 : static_cast<int>(std::ceil(std::pow(shoots, 1.0 / depth_) - 1e-9));
+        trunkLengthM_ = 0.5 * std::cbrt(static_cast<double>(p.leafCount)) * (p.leafLengthM / 0.1);
+    }
+
+    NodeId Build(const glm::dvec3& base) {
+        Node plant;
+        plant.id = next_++;
+        plant.type = NodeType::kPlant;
+        plant.name = "plant" + std::to_string(plant.id);
+        const glm::dmat4 world = FrameOf(base, {1, 0, 0}, {0, 1, 0}, {0, 0, 1});
+        plant.parentFromLocal = world;
+        const NodeId plantId = plant.id;
+        scene_.nodes.push_back(std::move(plant));
+        Random random(StreamSeed(p_.seed, 0));
+        Axis(plantId, world, glm::dvec3(0, 0, 1), 0, p_.leafCount, random);
+        return next_;
+    }
+
+private:
+    // Leaves an axis of depth `depth` can carry.
+    long Capacity(int depth) const {
+        long capacity = p_.leavesPerShoot;
+        for (int d = depth; d < depth_; ++d) capacity *= branching_;
+        return capacity;
+    }
+
+    NodeId Add(Node node, NodeId parent, const glm::dmat4& worldFromParent, const glm::dmat4& world) {
+        node.id = next_++;
+        node.parent = parent;
+        node.parentFromLocal = glm::inverse(worldFromParent) * world;
+        if (node.name.empty()) node.name = NodeTypeName(node.type) + std::to_string(node.id);
+        scene_.nodes.push_back(std::move(node));
+        return scene_.nodes.back().id;
+    }
+
+    void Axis(NodeId parent, const glm::dmat4& worldFromParent, const glm::dvec3& direction,
+              int depth, long leaves, Random& random) {
+        const glm::dvec3 base(worldFromParent[3]);
+        const glm::dvec3 side = AnyPerpendicular(direction);
+        const glm::dmat4 world = FrameOf(base, side, glm::cross(direction, side), direction);
+        Node axis;
+        axis.type = NodeType::kAxis;
+        axis.age = depth;
+        axis.attributes["order"] = depth;
+        const NodeId axisId = Add(std::move(axis), parent, worldFromParent, world);
+
+        const bool shoot = depth >= depth_;
+        const long childCapacity = shoot ? 1 : Capacity(depth + 1);
+        const int phytomers = static_cast<int>((leaves + childCapacity - 1) / childCapacity);
+        const double length = std::max(trunkLengthM_ * std::pow(0.55, depth),
+                                       0.35 * p_.leafLengthM * phytomers);
+        const double width = std::max(0.004, 0.03 * trunkLengthM_ * std::pow(0.5, depth) / 5.0);
+        const double firstAt = shoot ? 0.1 : (depth == 0 ? 0.35 : 0.2);
+        double previous = 0.0;
+        long left = leaves;
+        for (int i = 0; i < phytomers; ++i) {
+            const double s = length * (firstAt + (1.0 - firstAt) * (i + 1.0) / phytomers);
+            const glm::dvec3 at = base + direction * s;
+            const glm::dmat4 phytomerWorld = FrameOf(at, side, glm::cross(direction, side), direction);
+            Node phytomer;
+            phytomer.type = NodeType::kPhytomer;
+            phytomer.age = depth;
+            const NodeId phytomerId = Add(std::move(phytomer), axisId, world, phytomerWorld);
+            if (p_.internodes) {
+                Node internode;
+                internode.type = NodeType::kInternode;
+                internode.organ = Organ{internode_, p_.stemOptics};
+                const glm::dvec3 from = base + direction * previous;
+                Add(std::move(internode), phytomerId, phytomerWorld,
+                    FrameOf(from, side * width, glm::cross(direction, side) * width,
+                            direction * (s - previous)));
+            }
+            previous = s;
+            const double phyllotaxy =
+                glm::radians(kGoldenAngleDeg * i + 20.0 * (random.Uniform() - 0.5));
+            const glm::dvec3 around = Rotate(side, direction, phyllotaxy);
+            const long here = std::min(left, childCapacity);
+            left -= here;
+            if (shoot) {
+                Leaf(phytomerId, phytomerWorld, at, around, random);
+                continue;
+            }
+            const double angle = glm::radians(p_.branchAngleDeg + 10.0 * (random.Uniform() - 0.5));
+            const glm::dvec3 lateral = glm::normalize(std::cos(angle) * direction + std::sin(angle) * around);
+            Random childRandom(StreamSeed(p_.seed, next_));
+            Axis(phytomerId, FrameOf(at, side, glm::cross(direction, side), direction), lateral,
+                 depth + 1, here, childRandom);
+        }
+    }
+
+    // A blade pointing away from the axis along `around`, inclined and rolled at random.
+    void Leaf(NodeId phytomer, const glm::dmat4& phytomerWorld, const glm::dvec3& at,
+              const glm::dvec3& around, Random& random) {
+        glm::dvec3 horizontal(around.x, around.y, 0.0);
+        horizontal = glm::length(horizontal) > 1e-6 ? glm::normalize(horizontal) : glm::dvec3(1, 0, 0);
+        const glm::dvec3 across = glm::normalize(glm::cross(glm::dvec3(0, 0, 1), horizontal));
+        const double inclination =
+            glm::radians(p_.leafInclinationDeg + 40.0 * (random.Uniform() - 0.5));
+        const double roll = glm::radians(30.0 * (random.Uniform() - 0.5));
+        const glm::dvec3 blade = Rotate(horizontal, across, inclination);  // droops down
+        const glm::dvec3 width = Rotate(across, blade, roll);
+        const glm::dvec3 normal = glm::cross(blade, width);
+        const double length = p_.leafLengthM * (0.8 + 0.4 * random.Uniform());
+        Node leaf;
+        leaf.type = NodeType::kLeaf;
+        leaf.organ = Organ{leaf_, p_.leafOptics};
+        leaf.attributes["length_m"] = length;
+        Add(std::move(leaf), phytomer, phytomerWorld,
+            FrameOf(at, blade * length, width * (0.6 * length), normal));
+    }
+
+    Scene& scene_;
+    const TreeParameters& p_;
+    NodeId next_;
+    std::shared_ptr<const Mesh> leaf_, internode_;
+    int depth_ = 0;
+    int branching_ = 1;
+    double trunkLengthM_ = 1.0;
+};
+
+}  // namespace
+
+NodeId AddTree(Scene& scene, const TreeParameters& parameters, const glm::dvec3& base,
+               NodeId firstId) {
+    if (parameters.leafCount < 1 || parameters.leafCount > 10'000'000) {
+        throw InputError(ErrorCode::kInvalidArgument, "leaf_count", "must be between 1 and 10^7");
+    }
+    if (parameters.leavesPerShoot < 1 || parameters.maxBranching < 2) {
+        throw InputError(ErrorCode::kInvalidArgument, "leaves_per_shoot",
+                         "needs at least 1 leaf per shoot and a branching of 2");
+    }
+    if (!(parameters.leafLengthM > 0.0) || !std::isfinite(parameters.leafLengthM)) {
+        throw InputError(ErrorCode::kInvalidArgument, "leaf_length_m", "must be positive");
+    }
+    return TreeBuilder(scene, parameters, firstId).Build(base);
+}
+
+void AddPlantation(Scene& scene, const PlantationParameters& parameters,
+                   const std::string& groundOptics) {
+    if (parameters.rows < 1 || parameters.columns < 1) {
+        throw InputError(ErrorCode::kInvalidArgument, "rows", "needs at least one row and column");
+    }
+    const double azimuth = glm::radians(parameters.rowAzimuthDeg);
+    const glm::dvec3 along(std::sin(azimuth), std::cos(azimuth), 0.0);
+    const glm::dvec3 across(along.y, -along.x, 0.0);
+    NodeId next = 1;
+    for (const Node& node : scene.nodes) next = std::max(next, node.id + 1);
+    Random jitter(StreamSeed(parameters.tree.seed, 0xB0A7));
+    for (int r = 0; r < parameters.rows; ++r) {
+        for (int c = 0; c < parameters.columns; ++c) {
+            const double x = (c - 0.5 * (parameters.columns - 1)) * parameters.columnSpacingM +
+                             parameters.jitterM * (2.0 * jitter.Uniform() - 1.0);
+            const double y = (r - 0.5 * (parameters.rows - 1)) * parameters.rowSpacingM +
+                             parameters.jitterM * (2.0 * jitter.Uniform() - 1.0);
+            TreeParameters tree = parameters.tree;
+            tree.seed = StreamSeed(parameters.tree.seed, r, c);
+            next = AddTree(scene, tree, x * along + y * across, next);
+        }
+    }
+    if (groundOptics.empty()) return;
+    const double halfX = 0.5 * parameters.columns * parameters.columnSpacingM + parameters.jitterM;
+    const double halfY = 0.5 * parameters.rows * parameters.rowSpacingM + parameters.jitterM;
+    auto ground = std::make_shared<Mesh>();
+    for (const auto& [u, v] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
+        ground->positions.push_back(u * halfX * along + v * halfY * across);
+    }
+    // Upper side up whatever the rows' azimuth.
+    ground->triangles = glm::dot(glm::cross(ground->positions[1] - ground->positions[0],
+                                            ground->positions[2] - ground->positions[0]),
+                                 glm::dvec3(0, 0, 1)) > 0.0
+                            ? std::vector<glm::uvec3>{{0, 1, 2}, {0, 2, 3}}
+                            : std::vector<glm::uvec3>{{0, 2, 1}, {0, 3, 2}};
+    scene.environment.push_back({"ground", ground, groundOptics});
+}
+
+}  // namespace leaflux

@@ -1,0 +1,51 @@
+// Procedural plants for tests, benchmarks and examples: a poplar-like tree with a real
+// botanical hierarchy and self-similarity, and plantations of such trees.
+//
+// A tree is a trunk (order 0) of phytomers bearing lateral axes, whose phytomers bear
+// axes of the next order, down to leafy shoots: every axis is a smaller copy of its
+// parent's form (the self-similarity the paper's instantiation exploits, Soler 2003 §4.1).
+// Node types: plant → axis → phytomer → (internode, leaf, axis). Leaves share one
+// prototype mesh and internodes another; each organ is placed, turned and scaled by its
+// node's frame (z along the structure's main axis), so the output is instancing data.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "solver/scene.h"
+
+namespace leaflux {
+
+struct TreeParameters {
+    int leafCount = 1000;          // exact number of leaves, 1 to 10⁷
+    std::uint64_t seed = 1;
+    int leavesPerShoot = 10;       // leaves on a terminal shoot
+    int maxBranching = 10;         // lateral axes per axis, at most
+    double leafLengthM = 0.10;     // mean leaf blade length; width is 0.6 of it
+    double branchAngleDeg = 50.0;  // insertion angle of lateral axes
+    double leafInclinationDeg = 35.0;  // mean angle of the blade to the horizontal
+    bool internodes = true;        // give internodes geometry (opaque prisms)
+    std::string leafOptics = "leaf";
+    std::string stemOptics = "stem";
+};
+
+// Adds one tree to `scene` with its base at `base`, node ids from `firstId` on; returns
+// the next free id. The scene's optics must define the two optics ids.
+NodeId AddTree(Scene& scene, const TreeParameters& parameters, const glm::dvec3& base,
+               NodeId firstId = 1);
+
+struct PlantationParameters {
+    TreeParameters tree;
+    int rows = 1, columns = 1;
+    double rowSpacingM = 5.0, columnSpacingM = 5.0;
+    double jitterM = 0.5;          // uniform random offset of each tree, in x and y
+    double rowAzimuthDeg = 0.0;    // direction of the rows, from north clockwise
+};
+
+// rows × columns trees (each seeded from the tree seed and its position), centred on the
+// origin, on a ground rectangle of the plantation's extent (optics `groundOptics`; none
+// when empty). Returns the scene's bands and optics untouched: the caller declares them.
+void AddPlantation(Scene& scene, const PlantationParameters& parameters,
+                   const std::string& groundOptics);
+
+}  // namespace leaflux

@@ -1,0 +1,27 @@
+#include "solver/solve.h"
+
+namespace leaflux {
+
+PreparedScene::PreparedScene(const Scene& scene) : scene_(scene), flat_(Flatten(scene)) {
+    std::optional<PeriodicDomain> periodic;
+    if (scene.periodic) {
+        // The ray engine works in the flat scene's frame, centred on its bounds.
+        periodic = *scene.periodic;
+        periodic->xMin -= flat_.origin.x;
+        periodic->xMax -= flat_.origin.x;
+        periodic->yMin -= flat_.origin.y;
+        periodic->yMax -= flat_.origin.y;
+    }
+    rays_ = std::make_unique<RayScene>(flat_, periodic);
+}
+
+Solution Solve(const PreparedScene& prepared, const SolverSettings& settings) {
+    switch (settings.kind) {
+        case SolverKind::kMonteCarlo:
+            return SolveReference(prepared.Source(), prepared.Flat(), prepared.Rays(),
+                                  settings.monteCarlo);
+    }
+    return {};
+}
+
+}  // namespace leaflux

@@ -1,0 +1,38 @@
+// The small solver API the server and the command line call: one scene in, light out.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "solver/light.h"
+#include "solver/raytrace.h"
+#include "solver/reference.h"
+
+namespace leaflux {
+
+enum class SolverKind { kMonteCarlo };
+
+struct SolverSettings {
+    SolverKind kind = SolverKind::kMonteCarlo;
+    ReferenceOptions monteCarlo;
+};
+
+// A scene prepared for solving: flattened and committed to the ray engine. Build it once
+// and solve it as often as needed (other seeds, other settings).
+class PreparedScene {
+public:
+    explicit PreparedScene(const Scene& scene);  // scene must be valid and outlive this
+
+    const Scene& Source() const { return scene_; }
+    const FlatScene& Flat() const { return flat_; }
+    const RayScene& Rays() const { return *rays_; }
+
+private:
+    const Scene& scene_;
+    FlatScene flat_;
+    std::unique_ptr<RayScene> rays_;
+};
+
+Solution Solve(const PreparedScene& prepared, const SolverSettings& settings);
+
+}  // namespace leaflux
