@@ -18,7 +18,7 @@ namespace leaflux {
 namespace {
 
 struct SolveCommand {
-    std::string scene, solver = "mc", out, structures;
+    std::string scene, solver = "mc", out, structures, ply;
     int samples = 1024, replicates = 16, threads = 0;
     std::uint64_t seed = 1;
     bool quiet = false;
@@ -55,6 +55,11 @@ int RunSolve(const SolveCommand& command) {
         std::ofstream structures(command.structures);
         if (!structures) throw InputError(ErrorCode::kIo, command.structures, "cannot write");
         WriteStructureCsv(structures, scene, AggregateStructures(scene, prepared.Flat(), solution));
+    }
+    if (!command.ply.empty()) {
+        std::ofstream ply(command.ply);
+        if (!ply) throw InputError(ErrorCode::kIo, command.ply, "cannot write");
+        WritePly(ply, prepared.Flat(), solution, 0);
     }
     std::cout << Summary(command.solver, scene, prepared.Flat(), solution) << std::endl;
     return 0;
@@ -125,6 +130,7 @@ int main(int argc, char** argv) {
                                              "irradiance_lower_wm2,absorbed_w,light_x,light_y,light_z,"
                                              "stderr_upper_wm2,stderr_lower_wm2")->required();
     solveApp->add_option("--structures", solve.structures, "Per-structure CSV (plants, axes, phytomers)");
+    solveApp->add_option("--ply", solve.ply, "PLY of the triangles with the first band's irradiance");
     solveApp->add_flag("--quiet", solve.quiet, "No progress or log lines, only the summary");
 
     GenerateCommand generate;

@@ -64,6 +64,27 @@ void WriteStructureCsv(std::ostream& out, const Scene& scene,
     }
 }
 
+void WritePly(std::ostream& out, const FlatScene& flat, const Solution& solution, int band) {
+    out << "ply\nformat ascii 1.0\ncomment leaflux light, band " << band << "\n"
+        << "element vertex " << 3 * flat.triangles.size() << "\n"
+        << "property double x\nproperty double y\nproperty double z\n"
+        << "element face " << flat.triangles.size() << "\n"
+        << "property list uchar int vertex_indices\nproperty float irradiance_upper\n"
+        << "property float irradiance_lower\nproperty int receiver\nend_header\n";
+    for (const Triangle& t : flat.triangles) {
+        for (const glm::dvec3& p : {t.a, t.b, t.c}) {
+            const glm::dvec3 world = p + flat.origin;
+            out << Number(world.x) << ' ' << Number(world.y) << ' ' << Number(world.z) << '\n';
+        }
+    }
+    for (std::size_t i = 0; i < flat.triangles.size(); ++i) {
+        const BandLight& light = solution.light[flat.triangles[i].receiver][band];
+        out << "3 " << 3 * i << ' ' << 3 * i + 1 << ' ' << 3 * i + 2 << ' '
+            << Number(light.irradianceUpperWm2) << ' ' << Number(light.irradianceLowerWm2) << ' '
+            << flat.triangles[i].receiver << '\n';
+    }
+}
+
 std::string Summary(const std::string& solver, const Scene& scene, const FlatScene& flat,
                     const Solution& solution) {
     std::ostringstream text;

@@ -20,6 +20,10 @@ void WriteLeafCsv(std::ostream& out, const Scene& scene, const FlatScene& flat,
 void WriteStructureCsv(std::ostream& out, const Scene& scene,
                        const std::vector<StructureLight>& structures);
 
+// ASCII PLY of every triangle (world coordinates) with the light of band `band` on its
+// receiver as face properties: irradiance_upper, irradiance_lower (W/m²) and receiver.
+void WritePly(std::ostream& out, const FlatScene& flat, const Solution& solution, int band);
+
 // "<solver>: <receivers> receivers × <bands> bands in <t> s (cpu <c> s), peak <m> MiB,
 //  <rays> rays; <band>: incident … W, absorbed … W, escaped … W, residual …%".
 std::string Summary(const std::string& solver, const Scene& scene, const FlatScene& flat,

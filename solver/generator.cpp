@@ -62,7 +62,7 @@ public:
         depth_ = 0;
         while (std::pow(p.maxBranching, depth_) < shoots) ++depth_;
         branching_ = depth_ == 0 ? 1 : static_cast<int>(std::ceil(std::pow(shoots, 1.0 / depth_) - 1e-9));
-        trunkLengthM_ = 0.5 * std::cbrt(static_cast<double>(p.leafCount)) * (p.leafLengthM / 0.1);
+        trunkLengthM_ = 0.3 * std::cbrt(static_cast<double>(p.leafCount)) * (p.leafLengthM / 0.1);
     }
 
     NodeId Build(const glm::dvec3& base) {

@@ -488,7 +488,11 @@ Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScen
             for (int b = 0; b < bands; ++b) {
                 auto& [upper, lower, absorb, in, out, rest] = series[b];
                 BandLight& light = solution.light[r][b];
-                for (const Tally& t : tallies) {
+                for (std::size_t k = 0; k < tallies.size(); ++k) {
+                    const Tally& t = tallies[k];
+                    // Escape: radiosity times the escaping view fraction, the latter from the
+                    // next replicate so that the product of the two estimates is unbiased.
+                    const Tally& view = tallies[(k + 1) % tallies.size()];
                     double absorbedW = 0.0, escapedW = 0.0, incidentW = 0.0;
                     for (int s : {kUpper, kLower}) {
                         const double e = t.irradiance[s][b];
@@ -496,7 +500,7 @@ Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScen
                         // Radiosity of side s (emission aside): ρ_s E_s + τ_other→s E_other.
                         const double radiosity =
                             optics.rho[s][b] * e + optics.tau[1 - s][b] * t.irradiance[1 - s][b];
-                        escapedW += radiosity * t.escape[s];
+                        escapedW += radiosity * view.escape[s];
                         incidentW += t.direct[s][b];
                     }
                     upper.push_back(t.irradiance[kUpper][b]);
