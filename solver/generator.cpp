@@ -1,5 +1,7 @@
 #include "solver/generator.h"
 
+#include <glm/gtc/constants.hpp>
+
 #include <algorithm>
 #include <cmath>
 
@@ -33,23 +35,28 @@ glm::dvec3 Rotate(const glm::dvec3& v, const glm::dvec3& k, double angle) {
 }
 
 std::shared_ptr<const Mesh> LeafPrototype() {
-    // A blade along local x from the petiole (0) to the tip (1), of width 1 across y.
+    // A rhombic blade along local x from the petiole (0) to the tip (1), of width 1
+    // across y: two triangles, area 1/2 in local units.
     auto mesh = std::make_shared<Mesh>();
-    mesh->positions = {{0, 0, 0}, {0.3, -0.5, 0}, {0.7, -0.5, 0}, {1, 0, 0}, {0.7, 0.5, 0}, {0.3, 0.5, 0}};
-    mesh->triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 5}};
+    mesh->positions = {{0, 0, 0}, {0.4, -0.5, 0}, {1, 0, 0}, {0.4, 0.5, 0}};
+    mesh->triangles = {{0, 1, 2}, {0, 2, 3}};
     return mesh;
 }
 
 std::shared_ptr<const Mesh> InternodePrototype() {
-    // A square prism of unit side around local z, from z = 0 to 1, faces outwards.
+    // A triangular prism of unit width around local z, from z = 0 to 1, faces outwards
+    // and no caps: six triangles, the least that still casts a shadow from every side.
     auto mesh = std::make_shared<Mesh>();
-    const double h = 0.5;
-    mesh->positions = {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0},
-                       {-h, -h, 1}, {h, -h, 1}, {h, h, 1}, {-h, h, 1}};
-    for (unsigned i = 0; i < 4; ++i) {
-        const unsigned j = (i + 1) % 4;
-        mesh->triangles.push_back({i, j, j + 4});
-        mesh->triangles.push_back({i, j + 4, i + 4});
+    for (double z : {0.0, 1.0}) {
+        for (int k = 0; k < 3; ++k) {
+            const double a = 2.0 * glm::pi<double>() * k / 3.0;
+            mesh->positions.push_back({0.5 * std::cos(a), 0.5 * std::sin(a), z});
+        }
+    }
+    for (unsigned i = 0; i < 3; ++i) {
+        const unsigned j = (i + 1) % 3;
+        mesh->triangles.push_back({i, j, j + 3});
+        mesh->triangles.push_back({i, j + 3, i + 3});
     }
     return mesh;
 }
@@ -124,7 +131,9 @@ private:
             phytomer.type = NodeType::kPhytomer;
             phytomer.age = depth;
             const NodeId phytomerId = Add(std::move(phytomer), axisId, world, phytomerWorld);
-            if (p_.internodes) {
+            // Twigs of the leafy shoots carry no geometry: thin against the leaves around
+            // them, they would multiply the triangles for little light.
+            if (p_.internodes && !shoot) {
                 Node internode;
                 internode.type = NodeType::kInternode;
                 internode.organ = Organ{internode_, p_.stemOptics};

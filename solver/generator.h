@@ -21,10 +21,11 @@ struct TreeParameters {
     std::uint64_t seed = 1;
     int leavesPerShoot = 10;       // leaves on a terminal shoot
     int maxBranching = 10;         // lateral axes per axis, at most
-    double leafLengthM = 0.10;     // mean leaf blade length; width is 0.6 of it
+    double leafLengthM = 0.10;     // mean rhombic blade length; width is 0.6 of it
     double branchAngleDeg = 50.0;  // insertion angle of lateral axes
     double leafInclinationDeg = 35.0;  // mean angle of the blade to the horizontal
-    bool internodes = true;        // give internodes geometry (opaque prisms)
+    bool internodes = true;        // give internodes geometry (opaque prisms), but on the
+                                   // leafy shoots, whose twigs stay bare topology
     std::string leafOptics = "leaf";
     std::string stemOptics = "stem";
 };
