@@ -1,12 +1,12 @@
 // leaflux: the one-shot command line. `solve` lights a scene file, `generate` writes a
 // procedural tree or plantation as a scene file.
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
-
-#include <CLI/CLI.hpp>
-#include <spdlog/spdlog.h>
 
 #include "server/scene_proto.h"
 #include "solver/error.h"
@@ -34,10 +34,10 @@ int RunSolve(const SolveCommand& command) {
     settings.monteCarlo.seed = command.seed;
     settings.monteCarlo.threads = command.threads;
     if (!command.quiet) {
-        spdlog::info("{}: {} receivers, {} triangles, {} bands; loaded in {:.2f} s", command.scene,
-                     prepared.Flat().receivers.size(), prepared.Flat().triangles.size(),
-                     scene.bands.size(),
-                     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        spdlog::info(
+            "{}: {} receivers, {} triangles, {} bands; loaded in {:.2f} s", command.scene,
+            prepared.Flat().receivers.size(), prepared.Flat().triangles.size(), scene.bands.size(),
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         settings.monteCarlo.progress = [last = -1](double done) mutable {
             const int tenth = static_cast<int>(done * 10.0);
             if (tenth > last) {
@@ -92,10 +92,12 @@ int RunGenerate(const GenerateCommand& command) {
     const double h = glm::radians(command.sunElevation), a = glm::radians(command.sunAzimuth);
     scene.sources.suns.push_back(
         {{std::cos(h) * std::sin(a), std::cos(h) * std::cos(a), std::sin(h)},
-         {command.sunPar, command.sunNir}, 0.0});
+         {command.sunPar, command.sunNir},
+         0.0});
     if (!command.noSky) {
-        scene.sources.skies.push_back(
-            {SkyModel::kCieOvercast, {command.skyPar, command.skyNir}, SkyDiscretization::kContinuous});
+        scene.sources.skies.push_back({SkyModel::kCieOvercast,
+                                       {command.skyPar, command.skyNir},
+                                       SkyDiscretization::kContinuous});
     }
     scene.Validate();
     SaveSceneFile(scene, command.out);
@@ -111,41 +113,63 @@ int RunGenerate(const GenerateCommand& command) {
 
 int main(int argc, char** argv) {
     using namespace leaflux;
-    CLI::App app{"leaflux: light on plants by hierarchical radiosity, with a Monte Carlo reference"};
+    CLI::App app{
+        "leaflux: light on plants by hierarchical radiosity, with a Monte Carlo reference"};
     app.require_subcommand(1);
 
     SolveCommand solve;
-    CLI::App* solveApp = app.add_subcommand("solve", "Light a scene file and write per-organ results");
-    solveApp->add_option("--scene", solve.scene, "Scene file (protobuf text format, leaflux.v1.Scene)")
-        ->required()->check(CLI::ExistingFile);
+    CLI::App* solveApp =
+        app.add_subcommand("solve", "Light a scene file and write per-organ results");
+    solveApp
+        ->add_option("--scene", solve.scene, "Scene file (protobuf text format, leaflux.v1.Scene)")
+        ->required()
+        ->check(CLI::ExistingFile);
     solveApp->add_option("--solver", solve.solver, "Solver: mc (Monte Carlo reference)")
         ->check(CLI::IsMember({"mc"}));
-    solveApp->add_option("--samples", solve.samples, "mc: paths per receiver (standard error ~ 1/sqrt)")
+    solveApp
+        ->add_option("--samples", solve.samples, "mc: paths per receiver (standard error ~ 1/sqrt)")
         ->check(CLI::Range(2, 1 << 26));
-    solveApp->add_option("--replicates", solve.replicates, "mc: independent groups for the standard error")
+    solveApp
+        ->add_option("--replicates", solve.replicates,
+                     "mc: independent groups for the standard error")
         ->check(CLI::Range(2, 1024));
     solveApp->add_option("--seed", solve.seed, "mc: random seed (same seed, same result)");
-    solveApp->add_option("--threads", solve.threads, "Worker threads (0: every core)")->check(CLI::Range(0, 1024));
-    solveApp->add_option("--out", solve.out, "Per-organ CSV: organ,band,area_m2,irradiance_upper_wm2,"
-                                             "irradiance_lower_wm2,absorbed_w,light_x,light_y,light_z,"
-                                             "stderr_upper_wm2,stderr_lower_wm2")->required();
-    solveApp->add_option("--structures", solve.structures, "Per-structure CSV (plants, axes, phytomers)");
-    solveApp->add_option("--ply", solve.ply, "PLY of the triangles with the first band's irradiance");
+    solveApp->add_option("--threads", solve.threads, "Worker threads (0: every core)")
+        ->check(CLI::Range(0, 1024));
+    solveApp
+        ->add_option("--out", solve.out,
+                     "Per-organ CSV: organ,band,area_m2,irradiance_upper_wm2,"
+                     "irradiance_lower_wm2,absorbed_w,light_x,light_y,light_z,"
+                     "stderr_upper_wm2,stderr_lower_wm2")
+        ->required();
+    solveApp->add_option("--structures", solve.structures,
+                         "Per-structure CSV (plants, axes, phytomers)");
+    solveApp->add_option("--ply", solve.ply,
+                         "PLY of the triangles with the first band's irradiance");
     solveApp->add_flag("--quiet", solve.quiet, "No progress or log lines, only the summary");
 
     GenerateCommand generate;
-    CLI::App* generateApp = app.add_subcommand("generate", "Write a procedural poplar-like tree or plantation");
-    generateApp->add_option("--leaves", generate.tree.leafCount, "Leaves per tree")->check(CLI::Range(1, 10'000'000));
+    CLI::App* generateApp =
+        app.add_subcommand("generate", "Write a procedural poplar-like tree or plantation");
+    generateApp->add_option("--leaves", generate.tree.leafCount, "Leaves per tree")
+        ->check(CLI::Range(1, 10'000'000));
     generateApp->add_option("--seed", generate.tree.seed, "Random seed");
-    generateApp->add_option("--leaf-length", generate.tree.leafLengthM, "Mean leaf length (m)")->check(CLI::PositiveNumber);
+    generateApp->add_option("--leaf-length", generate.tree.leafLengthM, "Mean leaf length (m)")
+        ->check(CLI::PositiveNumber);
     generateApp->add_option("--rows", generate.rows, "Rows of trees")->check(CLI::Range(1, 1000));
-    generateApp->add_option("--columns", generate.columns, "Trees per row")->check(CLI::Range(1, 1000));
-    generateApp->add_option("--spacing", generate.spacing, "Distance between trees (m)")->check(CLI::PositiveNumber);
-    generateApp->add_option("--row-azimuth", generate.rowAzimuth, "Row direction from north, clockwise (deg)");
-    generateApp->add_option("--sun-elevation", generate.sunElevation, "Sun elevation (deg)")->check(CLI::Range(0.0, 90.0));
-    generateApp->add_option("--sun-azimuth", generate.sunAzimuth, "Sun azimuth from north, clockwise (deg)");
+    generateApp->add_option("--columns", generate.columns, "Trees per row")
+        ->check(CLI::Range(1, 1000));
+    generateApp->add_option("--spacing", generate.spacing, "Distance between trees (m)")
+        ->check(CLI::PositiveNumber);
+    generateApp->add_option("--row-azimuth", generate.rowAzimuth,
+                            "Row direction from north, clockwise (deg)");
+    generateApp->add_option("--sun-elevation", generate.sunElevation, "Sun elevation (deg)")
+        ->check(CLI::Range(0.0, 90.0));
+    generateApp->add_option("--sun-azimuth", generate.sunAzimuth,
+                            "Sun azimuth from north, clockwise (deg)");
     generateApp->add_flag("--no-sky", generate.noSky, "Sun only, no diffuse sky");
-    generateApp->add_flag("!--internodes", generate.tree.internodes, "No internode geometry (leaves only)");
+    generateApp->add_flag("!--internodes", generate.tree.internodes,
+                          "No internode geometry (leaves only)");
     generateApp->add_option("--out", generate.out, "Scene file to write")->required();
 
     CLI11_PARSE(app, argc, argv);

@@ -28,17 +28,22 @@ std::set<std::string> AddCanOptics(const v1::Import& import, const std::string& 
     std::vector<bool> seen(scene.bands.size(), false);
     for (const auto& [band, path] : import.can_optics()) {
         const int b = scene.BandIndex(band);
-        if (b < 0) throw InputError(ErrorCode::kNotFound, field + ".can_optics[" + band + "]", "names no declared band");
+        if (b < 0)
+            throw InputError(ErrorCode::kNotFound, field + ".can_optics[" + band + "]",
+                             "names no declared band");
         perBand[b] = ReadCanOptics((base / path).string());
         seen[b] = true;
     }
     for (std::size_t b = 0; b < seen.size(); ++b) {
-        if (!seen[b]) throw InputError(ErrorCode::kNotFound, field + ".can_optics", "has no .opt file for band " + scene.bands[b].name);
+        if (!seen[b])
+            throw InputError(ErrorCode::kNotFound, field + ".can_optics",
+                             "has no .opt file for band " + scene.bands[b].name);
     }
     const std::size_t species = perBand.front().species.size();
     for (const CanOptics& o : perBand) {
         if (o.species.size() != species) {
-            throw InputError(ErrorCode::kInvalidArgument, field + ".can_optics", "the .opt files declare different numbers of species");
+            throw InputError(ErrorCode::kInvalidArgument, field + ".can_optics",
+                             "the .opt files declare different numbers of species");
         }
     }
     std::set<std::string> created;
@@ -61,18 +66,21 @@ std::set<std::string> AddCanOptics(const v1::Import& import, const std::string& 
 
 std::string OpticsFor(const std::string& material, const v1::Import& import,
                       const std::set<std::string>& created, const std::string& field) {
-    if (const auto it = import.material_optics().find(material); it != import.material_optics().end()) {
+    if (const auto it = import.material_optics().find(material);
+        it != import.material_optics().end()) {
         return it->second;
     }
     if (created.count(material)) return material;
     if (!import.default_optics().empty()) return import.default_optics();
     throw InputError(ErrorCode::kNotFound, field + ".material_optics",
-                     "material '" + material + "' of " + import.path() + " has no optics: map it or set default_optics");
+                     "material '" + material + "' of " + import.path() +
+                         " has no optics: map it or set default_optics");
 }
 
 glm::dmat4 ImportFrame(const v1::Frame& frame, const std::string& field) {
     if (frame.m_size() == 0) return glm::dmat4(1.0);
-    if (frame.m_size() != 12) throw InputError(ErrorCode::kInvalidArgument, field, "needs 12 numbers");
+    if (frame.m_size() != 12)
+        throw InputError(ErrorCode::kInvalidArgument, field, "needs 12 numbers");
     glm::dmat4 m(1.0);
     for (int r = 0; r < 3; ++r) {
         for (int c = 0; c < 4; ++c) m[c][r] = frame.m(4 * r + c);
@@ -90,11 +98,16 @@ void ReadImports(const v1::Scene& message, Scene& scene, const std::filesystem::
         ImportedGeometry geometry;
         std::set<std::string> created;
         switch (FormatOf(import, field)) {
-            case v1::GEOMETRY_FORMAT_OBJ: geometry = ReadObj(path); break;
-            case v1::GEOMETRY_FORMAT_OPF: geometry = ReadOpf(path); break;
+            case v1::GEOMETRY_FORMAT_OBJ:
+                geometry = ReadObj(path);
+                break;
+            case v1::GEOMETRY_FORMAT_OPF:
+                geometry = ReadOpf(path);
+                break;
             default:
                 geometry = ReadCan(path);
-                if (import.can_optics_size() > 0) created = AddCanOptics(import, field, base, scene);
+                if (import.can_optics_size() > 0)
+                    created = AddCanOptics(import, field, base, scene);
                 break;
         }
         const glm::dmat4 frame = ImportFrame(import.frame(), field + ".frame");
@@ -106,7 +119,8 @@ void ReadImports(const v1::Scene& message, Scene& scene, const std::filesystem::
             } else {
                 node.parent += import.id_offset();
             }
-            if (node.organ) node.organ->opticsId = OpticsFor(node.organ->opticsId, import, created, field);
+            if (node.organ)
+                node.organ->opticsId = OpticsFor(node.organ->opticsId, import, created, field);
             scene.nodes.push_back(std::move(node));
         }
         for (Surface& surface : geometry.environment) {

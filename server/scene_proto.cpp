@@ -1,13 +1,13 @@
 #include "server/scene_proto.h"
 
+#include <google/protobuf/io/tokenizer.h>
+#include <google/protobuf/text_format.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
-
-#include <google/protobuf/io/tokenizer.h>
-#include <google/protobuf/text_format.h>
 
 #include "solver/error.h"
 #include "solver/importers.h"
@@ -33,7 +33,8 @@ std::vector<double> PerBand(const Scene& scene,
         seen[b] = true;
     }
     for (std::size_t b = 0; b < seen.size(); ++b) {
-        if (!seen[b]) Fail(ErrorCode::kNotFound, field, "has no value for band " + scene.bands[b].name);
+        if (!seen[b])
+            Fail(ErrorCode::kNotFound, field, "has no value for band " + scene.bands[b].name);
     }
     return result;
 }
@@ -42,8 +43,8 @@ glm::dmat4 FrameFromProto(const v1::Frame& frame, const std::string& field,
                           std::optional<NodeId> node = std::nullopt) {
     if (frame.m_size() == 0) return glm::dmat4(1.0);
     if (frame.m_size() != 12) {
-        Fail(ErrorCode::kInvalidArgument, field, "needs 12 numbers (3×4 row-major), got " +
-                                                     std::to_string(frame.m_size()), node);
+        Fail(ErrorCode::kInvalidArgument, field,
+             "needs 12 numbers (3×4 row-major), got " + std::to_string(frame.m_size()), node);
     }
     glm::dmat4 m(1.0);
     for (int r = 0; r < 3; ++r) {
@@ -94,46 +95,70 @@ void MeshToProto(const Mesh& mesh, v1::Mesh* message) {
 
 NodeType TypeFromProto(v1::NodeType type) {
     switch (type) {
-        case v1::NODE_TYPE_PLANT: return NodeType::kPlant;
-        case v1::NODE_TYPE_AXIS: return NodeType::kAxis;
-        case v1::NODE_TYPE_PHYTOMER: return NodeType::kPhytomer;
-        case v1::NODE_TYPE_LEAF: return NodeType::kLeaf;
-        case v1::NODE_TYPE_INTERNODE: return NodeType::kInternode;
-        case v1::NODE_TYPE_FRUIT: return NodeType::kFruit;
-        default: return NodeType::kOther;
+        case v1::NODE_TYPE_PLANT:
+            return NodeType::kPlant;
+        case v1::NODE_TYPE_AXIS:
+            return NodeType::kAxis;
+        case v1::NODE_TYPE_PHYTOMER:
+            return NodeType::kPhytomer;
+        case v1::NODE_TYPE_LEAF:
+            return NodeType::kLeaf;
+        case v1::NODE_TYPE_INTERNODE:
+            return NodeType::kInternode;
+        case v1::NODE_TYPE_FRUIT:
+            return NodeType::kFruit;
+        default:
+            return NodeType::kOther;
     }
 }
 
 v1::NodeType TypeToProto(NodeType type) {
     switch (type) {
-        case NodeType::kPlant: return v1::NODE_TYPE_PLANT;
-        case NodeType::kAxis: return v1::NODE_TYPE_AXIS;
-        case NodeType::kPhytomer: return v1::NODE_TYPE_PHYTOMER;
-        case NodeType::kLeaf: return v1::NODE_TYPE_LEAF;
-        case NodeType::kInternode: return v1::NODE_TYPE_INTERNODE;
-        case NodeType::kFruit: return v1::NODE_TYPE_FRUIT;
-        case NodeType::kOther: return v1::NODE_TYPE_OTHER;
+        case NodeType::kPlant:
+            return v1::NODE_TYPE_PLANT;
+        case NodeType::kAxis:
+            return v1::NODE_TYPE_AXIS;
+        case NodeType::kPhytomer:
+            return v1::NODE_TYPE_PHYTOMER;
+        case NodeType::kLeaf:
+            return v1::NODE_TYPE_LEAF;
+        case NodeType::kInternode:
+            return v1::NODE_TYPE_INTERNODE;
+        case NodeType::kFruit:
+            return v1::NODE_TYPE_FRUIT;
+        case NodeType::kOther:
+            return v1::NODE_TYPE_OTHER;
     }
     return v1::NODE_TYPE_OTHER;
 }
 
 SkyDiscretization DiscretizationFromProto(v1::SkyDiscretization d) {
     switch (d) {
-        case v1::SKY_DISCRETIZATION_TURTLE_46: return SkyDiscretization::kTurtle46;
-        case v1::SKY_DISCRETIZATION_TETRA_34: return SkyDiscretization::kTetra34;
-        case v1::SKY_DISCRETIZATION_TETRA_130: return SkyDiscretization::kTetra130;
-        case v1::SKY_DISCRETIZATION_TETRA_514: return SkyDiscretization::kTetra514;
-        default: return SkyDiscretization::kContinuous;
+        case v1::SKY_DISCRETIZATION_TURTLE_46:
+            return SkyDiscretization::kTurtle46;
+        case v1::SKY_DISCRETIZATION_TETRA_34:
+            return SkyDiscretization::kTetra34;
+        case v1::SKY_DISCRETIZATION_TETRA_130:
+            return SkyDiscretization::kTetra130;
+        case v1::SKY_DISCRETIZATION_TETRA_514:
+            return SkyDiscretization::kTetra514;
+        default:
+            return SkyDiscretization::kContinuous;
     }
 }
 
 v1::SkyDiscretization DiscretizationToProto(SkyDiscretization d) {
     switch (d) {
-        case SkyDiscretization::kTurtle46: return v1::SKY_DISCRETIZATION_TURTLE_46;
-        case SkyDiscretization::kTetra34: return v1::SKY_DISCRETIZATION_TETRA_34;
-        case SkyDiscretization::kTetra130: return v1::SKY_DISCRETIZATION_TETRA_130;
-        case SkyDiscretization::kTetra514: return v1::SKY_DISCRETIZATION_TETRA_514;
-        case SkyDiscretization::kContinuous: return v1::SKY_DISCRETIZATION_CONTINUOUS;
+        case SkyDiscretization::kTurtle46:
+            return v1::SKY_DISCRETIZATION_TURTLE_46;
+        case SkyDiscretization::kTetra34:
+            return v1::SKY_DISCRETIZATION_TETRA_34;
+        case SkyDiscretization::kTetra130:
+            return v1::SKY_DISCRETIZATION_TETRA_130;
+        case SkyDiscretization::kTetra514:
+            return v1::SKY_DISCRETIZATION_TETRA_514;
+        case SkyDiscretization::kContinuous:
+            return v1::SKY_DISCRETIZATION_CONTINUOUS;
     }
     return v1::SKY_DISCRETIZATION_CONTINUOUS;
 }
@@ -146,62 +171,80 @@ void ReadSources(const v1::Scene& message, Scene& scene, const std::filesystem::
         if (in.has_solar()) {
             const v1::SolarPosition& p = in.solar();
             if (!std::isfinite(p.latitude_deg()) || std::abs(p.latitude_deg()) > 90.0) {
-                Fail(ErrorCode::kInvalidArgument, field + ".solar.latitude_deg", "must be in [-90, 90]");
+                Fail(ErrorCode::kInvalidArgument, field + ".solar.latitude_deg",
+                     "must be in [-90, 90]");
             }
             if (p.day_of_year() < 1 || p.day_of_year() > 366) {
-                Fail(ErrorCode::kInvalidArgument, field + ".solar.day_of_year", "must be in [1, 366]");
+                Fail(ErrorCode::kInvalidArgument, field + ".solar.day_of_year",
+                     "must be in [1, 366]");
             }
-            if (!std::isfinite(p.solar_time_h()) || p.solar_time_h() < 0.0 || p.solar_time_h() > 24.0) {
-                Fail(ErrorCode::kInvalidArgument, field + ".solar.solar_time_h", "must be in [0, 24]");
+            if (!std::isfinite(p.solar_time_h()) || p.solar_time_h() < 0.0 ||
+                p.solar_time_h() > 24.0) {
+                Fail(ErrorCode::kInvalidArgument, field + ".solar.solar_time_h",
+                     "must be in [0, 24]");
             }
-            sun.towardSun = DirectionFromAngles(SolarPosition(p.latitude_deg(), p.day_of_year(), p.solar_time_h()));
+            sun.towardSun = DirectionFromAngles(
+                SolarPosition(p.latitude_deg(), p.day_of_year(), p.solar_time_h()));
         } else {
             const glm::dvec3 d(in.direction().x(), in.direction().y(), in.direction().z());
             const double length = glm::length(d);
             if (!std::isfinite(length) || length == 0.0) {
-                Fail(ErrorCode::kInvalidArgument, field + ".direction", "must be a finite non-zero vector");
+                Fail(ErrorCode::kInvalidArgument, field + ".direction",
+                     "must be a finite non-zero vector");
             }
             sun.towardSun = d / length;
         }
-        sun.normalIrradianceWm2 = PerBand(scene, in.normal_irradiance(), field + ".normal_irradiance");
+        sun.normalIrradianceWm2 =
+            PerBand(scene, in.normal_irradiance(), field + ".normal_irradiance");
         sun.angularRadiusRad = glm::radians(in.angular_radius_deg());
         scene.sources.suns.push_back(std::move(sun));
     }
     for (int i = 0; i < message.sun_periods_size(); ++i) {
         const v1::SunPeriod& p = message.sun_periods(i);
         const std::string field = "sun_periods[" + std::to_string(i) + "]";
-        if (!(p.step_h() > 0.0) || !(p.end_h() > p.start_h()) || p.start_h() < 0.0 || p.end_h() > 24.0) {
-            Fail(ErrorCode::kInvalidArgument, field, "needs 0 <= start_h < end_h <= 24 and step_h > 0");
+        if (!(p.step_h() > 0.0) || !(p.end_h() > p.start_h()) || p.start_h() < 0.0 ||
+            p.end_h() > 24.0) {
+            Fail(ErrorCode::kInvalidArgument, field,
+                 "needs 0 <= start_h < end_h <= 24 and step_h > 0");
         }
         if (p.day_of_year() < 1 || p.day_of_year() > 366 || std::abs(p.latitude_deg()) > 90.0) {
-            Fail(ErrorCode::kInvalidArgument, field, "needs a day of year in [1, 366] and a latitude in [-90, 90]");
+            Fail(ErrorCode::kInvalidArgument, field,
+                 "needs a day of year in [1, 366] and a latitude in [-90, 90]");
         }
-        const auto suns = SunPositionsOverPeriod(p.latitude_deg(), p.day_of_year(), p.start_h(), p.end_h(),
-                                                 p.step_h(), PerBand(scene, p.normal_irradiance(), field + ".normal_irradiance"));
+        const auto suns = SunPositionsOverPeriod(
+            p.latitude_deg(), p.day_of_year(), p.start_h(), p.end_h(), p.step_h(),
+            PerBand(scene, p.normal_irradiance(), field + ".normal_irradiance"));
         scene.sources.suns.insert(scene.sources.suns.end(), suns.begin(), suns.end());
     }
     if (message.has_sky()) {
         Sky sky;
-        sky.model = message.sky().model() == v1::SKY_MODEL_CIE_OVERCAST ? SkyModel::kCieOvercast : SkyModel::kUniform;
-        sky.horizontalIrradianceWm2 = PerBand(scene, message.sky().horizontal_irradiance(), "sky.horizontal_irradiance");
+        sky.model = message.sky().model() == v1::SKY_MODEL_CIE_OVERCAST ? SkyModel::kCieOvercast
+                                                                        : SkyModel::kUniform;
+        sky.horizontalIrradianceWm2 =
+            PerBand(scene, message.sky().horizontal_irradiance(), "sky.horizontal_irradiance");
         sky.discretization = DiscretizationFromProto(message.sky().discretization());
         scene.sources.skies.push_back(std::move(sky));
     }
     for (int i = 0; i < message.emitters_size(); ++i) {
         const v1::Emitter& in = message.emitters(i);
-        const std::string field = "emitters[" + (in.name().empty() ? std::to_string(i) : in.name()) + "]";
+        const std::string field =
+            "emitters[" + (in.name().empty() ? std::to_string(i) : in.name()) + "]";
         scene.sources.emitters.push_back({in.name(), MeshFromProto(in.mesh(), field + ".mesh"),
-                                          PerBand(scene, in.exitance(), field + ".exitance"), in.optics()});
+                                          PerBand(scene, in.exitance(), field + ".exitance"),
+                                          in.optics()});
     }
     for (int i = 0; i < message.can_lights_size(); ++i) {
         const v1::CanLights& in = message.can_lights(i);
         const std::string field = "can_lights[" + std::to_string(i) + "]";
         const std::vector<double> scale = PerBand(scene, in.scale(), field + ".scale");
         for (const CanLight& light : ReadCanLights((base / in.path()).string())) {
-            if (light.towardSource.z <= 0.0) continue;  // below the horizon: lights nothing from the sky
+            if (light.towardSource.z <= 0.0)
+                continue;  // below the horizon: lights nothing from the sky
             Sun sun;
             sun.towardSun = light.towardSource;
-            for (double s : scale) sun.normalIrradianceWm2.push_back(s * light.horizontalIrradiance / light.towardSource.z);
+            for (double s : scale)
+                sun.normalIrradianceWm2.push_back(s * light.horizontalIrradiance /
+                                                  light.towardSource.z);
             scene.sources.suns.push_back(std::move(sun));
         }
     }
@@ -229,17 +272,23 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory) {
         std::vector<bool> seen(scene.bands.size(), false);
         for (const auto& [band, values] : optics.bands()) {
             const int b = scene.BandIndex(band);
-            if (b < 0) Fail(ErrorCode::kNotFound, field + ".bands[" + band + "]", "names no declared band");
-            o.bands[b] = {values.rho_upper(), values.rho_lower(), values.tau_upper(), values.tau_lower()};
+            if (b < 0)
+                Fail(ErrorCode::kNotFound, field + ".bands[" + band + "]",
+                     "names no declared band");
+            o.bands[b] = {values.rho_upper(), values.rho_lower(), values.tau_upper(),
+                          values.tau_lower()};
             seen[b] = true;
         }
         for (std::size_t b = 0; b < seen.size(); ++b) {
-            if (!seen[b]) Fail(ErrorCode::kNotFound, field + ".bands", "has no properties for band " + scene.bands[b].name);
+            if (!seen[b])
+                Fail(ErrorCode::kNotFound, field + ".bands",
+                     "has no properties for band " + scene.bands[b].name);
         }
         scene.optics.push_back(std::move(o));
     }
     std::map<std::string, std::shared_ptr<const Mesh>> meshes;
-    for (const auto& [name, mesh] : message.meshes()) meshes[name] = MeshFromProto(mesh, "meshes[" + name + "]");
+    for (const auto& [name, mesh] : message.meshes())
+        meshes[name] = MeshFromProto(mesh, "meshes[" + name + "]");
     for (const v1::Node& in : message.nodes()) {
         Node node;
         node.id = in.id();
@@ -254,7 +303,9 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory) {
             std::shared_ptr<const Mesh> mesh;
             if (organ.has_mesh_ref()) {
                 const auto it = meshes.find(organ.mesh_ref());
-                if (it == meshes.end()) Fail(ErrorCode::kNotFound, "organ.mesh_ref", "names no mesh '" + organ.mesh_ref() + "'", in.id());
+                if (it == meshes.end())
+                    Fail(ErrorCode::kNotFound, "organ.mesh_ref",
+                         "names no mesh '" + organ.mesh_ref() + "'", in.id());
                 mesh = it->second;
             } else {
                 mesh = MeshFromProto(organ.mesh(), "organ.mesh", in.id());
@@ -264,8 +315,10 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory) {
         scene.nodes.push_back(std::move(node));
     }
     for (const v1::Surface& surface : message.environment()) {
-        scene.environment.push_back({surface.name(), MeshFromProto(surface.mesh(), "environment[" + surface.name() + "].mesh"),
-                                     surface.optics()});
+        scene.environment.push_back(
+            {surface.name(),
+             MeshFromProto(surface.mesh(), "environment[" + surface.name() + "].mesh"),
+             surface.optics()});
     }
     ReadSources(message, scene, base);
     if (message.has_periodic()) {
@@ -330,7 +383,8 @@ v1::Scene ToProto(const Scene& scene) {
         s->set_optics(surface.opticsId);
         MeshToProto(*surface.mesh, s->mutable_mesh());
     }
-    auto perBand = [&](const std::vector<double>& values, google::protobuf::Map<std::string, double>* map) {
+    auto perBand = [&](const std::vector<double>& values,
+                       google::protobuf::Map<std::string, double>* map) {
         for (std::size_t b = 0; b < values.size(); ++b) (*map)[scene.bands[b].name] = values[b];
     };
     for (const Sun& sun : scene.sources.suns) {
@@ -344,7 +398,8 @@ v1::Scene ToProto(const Scene& scene) {
     if (!scene.sources.skies.empty()) {
         const Sky& sky = scene.sources.skies.front();
         v1::Sky* s = message.mutable_sky();
-        s->set_model(sky.model == SkyModel::kCieOvercast ? v1::SKY_MODEL_CIE_OVERCAST : v1::SKY_MODEL_UNIFORM);
+        s->set_model(sky.model == SkyModel::kCieOvercast ? v1::SKY_MODEL_CIE_OVERCAST
+                                                         : v1::SKY_MODEL_UNIFORM);
         perBand(sky.horizontalIrradianceWm2, s->mutable_horizontal_irradiance());
         s->set_discretization(DiscretizationToProto(sky.discretization));
     }
@@ -367,13 +422,15 @@ v1::Scene ToProto(const Scene& scene) {
 
 namespace {
 class CollectErrors : public google::protobuf::io::ErrorCollector {
-public:
-    void AddError(int line, google::protobuf::io::ColumnNumber column, const std::string& message) override {
-        if (first_.empty()) first_ = std::to_string(line + 1) + ":" + std::to_string(column + 1) + ": " + message;
+  public:
+    void AddError(int line, google::protobuf::io::ColumnNumber column,
+                  const std::string& message) override {
+        if (first_.empty())
+            first_ = std::to_string(line + 1) + ":" + std::to_string(column + 1) + ": " + message;
     }
     const std::string& First() const { return first_; }
 
-private:
+  private:
     std::string first_;
 };
 }  // namespace
@@ -390,7 +447,8 @@ Scene LoadSceneFile(const std::string& path) {
     if (!parser.ParseFromString(text.str(), &message)) {
         const std::string& first = errors.First();
         const auto colon = first.find(": ");
-        Fail(ErrorCode::kParse, path + ":" + first.substr(0, colon), colon == std::string::npos ? first : first.substr(colon + 2));
+        Fail(ErrorCode::kParse, path + ":" + first.substr(0, colon),
+             colon == std::string::npos ? first : first.substr(colon + 2));
     }
     return FromProto(message, std::filesystem::path(path).parent_path().string());
 }

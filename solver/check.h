@@ -10,7 +10,7 @@
 namespace leaflux {
 
 class InternalError : public std::logic_error {
-public:
+  public:
     using std::logic_error::logic_error;
 };
 
@@ -32,21 +32,21 @@ template <typename A, typename B>
 
 }  // namespace leaflux
 
-#define LEAFLUX_CHECK(condition)                                         \
-    do {                                                                 \
-        if (!(condition)) {                                              \
+#define LEAFLUX_CHECK(condition)                                            \
+    do {                                                                    \
+        if (!(condition)) {                                                 \
             ::leaflux::detail::CheckFailed(__FILE__, __LINE__, #condition); \
-        }                                                                \
+        }                                                                   \
     } while (false)
 
-#define LEAFLUX_CHECK_OP(a, op, b)                                                       \
-    do {                                                                                 \
-        const auto& leafluxCheckA = (a);                                                 \
-        const auto& leafluxCheckB = (b);                                                 \
-        if (!(leafluxCheckA op leafluxCheckB)) {                                         \
-            ::leaflux::detail::CheckOpFailed(__FILE__, __LINE__, #a " " #op " " #b,      \
-                                             leafluxCheckA, leafluxCheckB);              \
-        }                                                                                \
+#define LEAFLUX_CHECK_OP(a, op, b)                                                                 \
+    do {                                                                                           \
+        const auto& leafluxCheckA = (a);                                                           \
+        const auto& leafluxCheckB = (b);                                                           \
+        if (!(leafluxCheckA op leafluxCheckB)) {                                                   \
+            ::leaflux::detail::CheckOpFailed(__FILE__, __LINE__, #a " " #op " " #b, leafluxCheckA, \
+                                             leafluxCheckB);                                       \
+        }                                                                                          \
     } while (false)
 
 #define LEAFLUX_CHECK_EQ(a, b) LEAFLUX_CHECK_OP(a, ==, b)

@@ -24,8 +24,7 @@ bool InsideFace(const glm::dvec3& d, const glm::dvec3& a, const glm::dvec3& b,
 }
 }  // namespace
 
-double SphericalTriangleSolidAngle(const glm::dvec3& a, const glm::dvec3& b,
-                                   const glm::dvec3& c) {
+double SphericalTriangleSolidAngle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
     const double numerator = std::abs(glm::dot(a, glm::cross(b, c)));
     const double denominator = 1.0 + glm::dot(a, b) + glm::dot(b, c) + glm::dot(c, a);
     return 2.0 * std::atan2(numerator, denominator);

@@ -7,14 +7,13 @@
 #pragma once
 
 #include <array>
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 namespace leaflux {
 
 class DirectionSet {
-public:
+  public:
     // level 0..4 → 4, 10, 34, 130, 514 directions. One vertex of the tetrahedron is the
     // zenith (0, 0, 1), so every set has a direction straight up.
     static const DirectionSet& OfLevel(int level);
@@ -34,7 +33,7 @@ public:
     // The vertex of the containing face nearest to `direction`: the set's cell partition.
     int Nearest(const glm::dvec3& direction) const;
 
-private:
+  private:
     explicit DirectionSet(int level);
     int LocateFace(const glm::dvec3& unitDirection) const;
 

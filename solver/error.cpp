@@ -13,14 +13,22 @@ std::string Describe(ErrorCode code, const std::string& field, const std::string
 
 const char* ErrorCodeName(ErrorCode code) {
     switch (code) {
-        case ErrorCode::kInvalidArgument: return "invalid_argument";
-        case ErrorCode::kNotFound: return "not_found";
-        case ErrorCode::kAlreadyExists: return "already_exists";
-        case ErrorCode::kDegenerate: return "degenerate";
-        case ErrorCode::kCycle: return "cycle";
-        case ErrorCode::kParse: return "parse";
-        case ErrorCode::kIo: return "io";
-        case ErrorCode::kUnsupported: return "unsupported";
+        case ErrorCode::kInvalidArgument:
+            return "invalid_argument";
+        case ErrorCode::kNotFound:
+            return "not_found";
+        case ErrorCode::kAlreadyExists:
+            return "already_exists";
+        case ErrorCode::kDegenerate:
+            return "degenerate";
+        case ErrorCode::kCycle:
+            return "cycle";
+        case ErrorCode::kParse:
+            return "parse";
+        case ErrorCode::kIo:
+            return "io";
+        case ErrorCode::kUnsupported:
+            return "unsupported";
     }
     return "unknown";
 }

@@ -24,7 +24,7 @@ enum class ErrorCode {
 const char* ErrorCodeName(ErrorCode code);
 
 class InputError : public std::runtime_error {
-public:
+  public:
     InputError(ErrorCode code, std::string field, const std::string& message,
                std::optional<std::uint64_t> node = std::nullopt);
 
@@ -34,7 +34,7 @@ public:
     // The botanical node the error concerns, when there is one.
     std::optional<std::uint64_t> Node() const { return node_; }
 
-private:
+  private:
     ErrorCode code_;
     std::string field_;
     std::optional<std::uint64_t> node_;

@@ -23,8 +23,8 @@ std::string Quoted(const std::string& text) {
 void WriteLight(std::ostream& out, const BandLight& light) {
     const glm::dvec3 v = light.LightVector();
     out << Number(light.irradianceUpperWm2) << ',' << Number(light.irradianceLowerWm2) << ','
-        << Number(light.absorbedW) << ',' << Number(v.x) << ',' << Number(v.y) << ','
-        << Number(v.z) << ',';
+        << Number(light.absorbedW) << ',' << Number(v.x) << ',' << Number(v.y) << ',' << Number(v.z)
+        << ',';
     if (light.stderrUpperWm2 >= 0.0) {
         out << Number(light.stderrUpperWm2) << ',' << Number(light.stderrLowerWm2);
     } else {

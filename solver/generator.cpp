@@ -1,9 +1,8 @@
 #include "solver/generator.h"
 
-#include <glm/gtc/constants.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <glm/gtc/constants.hpp>
 
 #include "solver/check.h"
 #include "solver/error.h"
@@ -25,7 +24,8 @@ glm::dmat4 FrameOf(const glm::dvec3& origin, const glm::dvec3& x, const glm::dve
 }
 
 glm::dvec3 AnyPerpendicular(const glm::dvec3& a) {
-    return glm::normalize(glm::cross(a, std::abs(a.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0)));
+    return glm::normalize(
+        glm::cross(a, std::abs(a.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0)));
 }
 
 // `v` turned by `angle` around the unit axis `k` (Rodrigues).
@@ -62,13 +62,18 @@ std::shared_ptr<const Mesh> InternodePrototype() {
 }
 
 class TreeBuilder {
-public:
+  public:
     TreeBuilder(Scene& scene, const TreeParameters& p, NodeId firstId)
-        : scene_(scene), p_(p), next_(firstId), leaf_(LeafPrototype()), internode_(InternodePrototype()) {
+        : scene_(scene),
+          p_(p),
+          next_(firstId),
+          leaf_(LeafPrototype()),
+          internode_(InternodePrototype()) {
         const int shoots = (p.leafCount + p.leavesPerShoot - 1) / p.leavesPerShoot;
         depth_ = 0;
         while (std::pow(p.maxBranching, depth_) < shoots) ++depth_;
-        branching_ = depth_ == 0 ? 1 : static_cast<int>(std::ceil(std::pow(shoots, 1.0 / depth_) - 1e-9));
+        branching_ =
+            depth_ == 0 ? 1 : static_cast<int>(std::ceil(std::pow(shoots, 1.0 / depth_) - 1e-9));
         trunkLengthM_ = 0.3 * std::cbrt(static_cast<double>(p.leafCount)) * (p.leafLengthM / 0.1);
     }
 
@@ -86,7 +91,7 @@ public:
         return next_;
     }
 
-private:
+  private:
     // Leaves an axis of depth `depth` can carry.
     long Capacity(int depth) const {
         long capacity = p_.leavesPerShoot;
@@ -94,7 +99,8 @@ private:
         return capacity;
     }
 
-    NodeId Add(Node node, NodeId parent, const glm::dmat4& worldFromParent, const glm::dmat4& world) {
+    NodeId Add(Node node, NodeId parent, const glm::dmat4& worldFromParent,
+               const glm::dmat4& world) {
         node.id = next_++;
         node.parent = parent;
         node.parentFromLocal = glm::inverse(worldFromParent) * world;
@@ -117,8 +123,8 @@ private:
         const bool shoot = depth >= depth_;
         const long childCapacity = shoot ? 1 : Capacity(depth + 1);
         const int phytomers = static_cast<int>((leaves + childCapacity - 1) / childCapacity);
-        const double length = std::max(trunkLengthM_ * std::pow(0.55, depth),
-                                       0.35 * p_.leafLengthM * phytomers);
+        const double length =
+            std::max(trunkLengthM_ * std::pow(0.55, depth), 0.35 * p_.leafLengthM * phytomers);
         const double width = std::max(0.004, 0.03 * trunkLengthM_ * std::pow(0.5, depth) / 5.0);
         const double firstAt = shoot ? 0.1 : (depth == 0 ? 0.35 : 0.2);
         double previous = 0.0;
@@ -126,7 +132,8 @@ private:
         for (int i = 0; i < phytomers; ++i) {
             const double s = length * (firstAt + (1.0 - firstAt) * (i + 1.0) / phytomers);
             const glm::dvec3 at = base + direction * s;
-            const glm::dmat4 phytomerWorld = FrameOf(at, side, glm::cross(direction, side), direction);
+            const glm::dmat4 phytomerWorld =
+                FrameOf(at, side, glm::cross(direction, side), direction);
             Node phytomer;
             phytomer.type = NodeType::kPhytomer;
             phytomer.age = depth;
@@ -153,7 +160,8 @@ private:
                 continue;
             }
             const double angle = glm::radians(p_.branchAngleDeg + 10.0 * (random.Uniform() - 0.5));
-            const glm::dvec3 lateral = glm::normalize(std::cos(angle) * direction + std::sin(angle) * around);
+            const glm::dvec3 lateral =
+                glm::normalize(std::cos(angle) * direction + std::sin(angle) * around);
             Random childRandom(StreamSeed(p_.seed, next_));
             Axis(phytomerId, FrameOf(at, side, glm::cross(direction, side), direction), lateral,
                  depth + 1, here, childRandom);
@@ -164,7 +172,8 @@ private:
     void Leaf(NodeId phytomer, const glm::dmat4& phytomerWorld, const glm::dvec3& at,
               const glm::dvec3& around, Random& random) {
         glm::dvec3 horizontal(around.x, around.y, 0.0);
-        horizontal = glm::length(horizontal) > 1e-6 ? glm::normalize(horizontal) : glm::dvec3(1, 0, 0);
+        horizontal =
+            glm::length(horizontal) > 1e-6 ? glm::normalize(horizontal) : glm::dvec3(1, 0, 0);
         const glm::dvec3 across = glm::normalize(glm::cross(glm::dvec3(0, 0, 1), horizontal));
         const double inclination =
             glm::radians(p_.leafInclinationDeg + 40.0 * (random.Uniform() - 0.5));

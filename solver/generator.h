@@ -17,15 +17,15 @@
 namespace leaflux {
 
 struct TreeParameters {
-    int leafCount = 1000;          // exact number of leaves, 1 to 10⁷
+    int leafCount = 1000;  // exact number of leaves, 1 to 10⁷
     std::uint64_t seed = 1;
-    int leavesPerShoot = 10;       // leaves on a terminal shoot
-    int maxBranching = 10;         // lateral axes per axis, at most
-    double leafLengthM = 0.10;     // mean rhombic blade length; width is 0.6 of it
-    double branchAngleDeg = 50.0;  // insertion angle of lateral axes
+    int leavesPerShoot = 10;           // leaves on a terminal shoot
+    int maxBranching = 10;             // lateral axes per axis, at most
+    double leafLengthM = 0.10;         // mean rhombic blade length; width is 0.6 of it
+    double branchAngleDeg = 50.0;      // insertion angle of lateral axes
     double leafInclinationDeg = 35.0;  // mean angle of the blade to the horizontal
-    bool internodes = true;        // give internodes geometry (opaque prisms), but on the
-                                   // leafy shoots, whose twigs stay bare topology
+    bool internodes = true;            // give internodes geometry (opaque prisms), but on the
+                                       // leafy shoots, whose twigs stay bare topology
     std::string leafOptics = "leaf";
     std::string stemOptics = "stem";
 };
@@ -39,8 +39,8 @@ struct PlantationParameters {
     TreeParameters tree;
     int rows = 1, columns = 1;
     double rowSpacingM = 5.0, columnSpacingM = 5.0;
-    double jitterM = 0.5;          // uniform random offset of each tree, in x and y
-    double rowAzimuthDeg = 0.0;    // direction of the rows, from north clockwise
+    double jitterM = 0.5;        // uniform random offset of each tree, in x and y
+    double rowAzimuthDeg = 0.0;  // direction of the rows, from north clockwise
 };
 
 // rows × columns trees (each seeded from the tree seed and its position), centred on the

@@ -8,11 +8,10 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "solver/scene.h"
 
@@ -23,23 +22,23 @@ enum class ReceiverKind { kOrgan, kEnvironment, kEmitter };
 struct Receiver {
     std::string name;
     ReceiverKind kind = ReceiverKind::kOrgan;
-    NodeId node = 0;           // the organ's node; 0 for environment surfaces and emitters
-    int optics = -1;           // index into Scene::optics; -1: black (an emitter without optics)
-    int emitter = -1;          // index into Sources::emitters when kind == kEmitter
+    NodeId node = 0;   // the organ's node; 0 for environment surfaces and emitters
+    int optics = -1;   // index into Scene::optics; -1: black (an emitter without optics)
+    int emitter = -1;  // index into Sources::emitters when kind == kEmitter
     double areaM2 = 0.0;
     std::uint32_t firstTriangle = 0;
     std::uint32_t triangleCount = 0;
 };
 
 struct Triangle {
-    glm::dvec3 a, b, c;         // relative to FlatScene::origin
-    glm::dvec3 normal;          // unit, right-hand rule on a, b, c: the upper side
+    glm::dvec3 a, b, c;  // relative to FlatScene::origin
+    glm::dvec3 normal;   // unit, right-hand rule on a, b, c: the upper side
     double areaM2;
     std::uint32_t receiver;
 };
 
 struct FlatScene {
-    glm::dvec3 origin{0.0};            // world position of the local frame's origin
+    glm::dvec3 origin{0.0};                     // world position of the local frame's origin
     glm::dvec3 boundsMin{0.0}, boundsMax{0.0};  // local frame
     std::vector<Triangle> triangles;
     std::vector<Receiver> receivers;

@@ -2,8 +2,8 @@
 // attributes and text; no DTD, no namespaces, which OPF files do not use.
 #include <algorithm>
 #include <cctype>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -34,8 +34,9 @@ struct XmlElement {
 };
 
 class XmlReader {
-public:
-    XmlReader(std::string text, std::string path) : text_(std::move(text)), path_(std::move(path)) {}
+  public:
+    XmlReader(std::string text, std::string path)
+        : text_(std::move(text)), path_(std::move(path)) {}
 
     std::unique_ptr<XmlElement> Document() {
         SkipMisc();
@@ -44,7 +45,7 @@ public:
         return root;
     }
 
-private:
+  private:
     [[noreturn]] void Fail(const std::string& message) const {
         throw InputError(ErrorCode::kParse, path_ + ":" + std::to_string(Line()), message);
     }
@@ -64,17 +65,21 @@ private:
     void SkipMisc() {
         for (;;) {
             SkipSpace();
-            if (Starts("<?")) SkipPast("?>");
-            else if (Starts("<!--")) SkipPast("-->");
-            else if (Starts("<!")) SkipPast(">");
-            else return;
+            if (Starts("<?"))
+                SkipPast("?>");
+            else if (Starts("<!--"))
+                SkipPast("-->");
+            else if (Starts("<!"))
+                SkipPast(">");
+            else
+                return;
         }
     }
     std::string Name() {
         const std::size_t start = at_;
-        while (at_ < text_.size() && (std::isalnum(static_cast<unsigned char>(text_[at_])) ||
-                                      text_[at_] == '_' || text_[at_] == '-' ||
-                                      text_[at_] == ':' || text_[at_] == '.')) {
+        while (at_ < text_.size() &&
+               (std::isalnum(static_cast<unsigned char>(text_[at_])) || text_[at_] == '_' ||
+                text_[at_] == '-' || text_[at_] == ':' || text_[at_] == '.')) {
             ++at_;
         }
         if (at_ == start) Fail("expected a name");
@@ -112,7 +117,8 @@ private:
             if (at_ >= text_.size()) Fail("element <" + element->name + "> is not closed");
             if (Starts("</")) {
                 at_ += 2;
-                if (Name() != element->name) Fail("mismatched closing tag for <" + element->name + ">");
+                if (Name() != element->name)
+                    Fail("mismatched closing tag for <" + element->name + ">");
                 SkipSpace();
                 if (!Starts(">")) Fail("expected '>'");
                 ++at_;
@@ -154,9 +160,11 @@ std::shared_ptr<Mesh> ReadMesh(const XmlElement& element, const std::string& pat
     const std::string at = path + ":" + std::to_string(element.line);
     const XmlElement* points = element.Child("points");
     const XmlElement* faces = element.Child("faces");
-    if (!points || !faces) throw InputError(ErrorCode::kParse, at, "a mesh needs <points> and <faces>");
+    if (!points || !faces)
+        throw InputError(ErrorCode::kParse, at, "a mesh needs <points> and <faces>");
     const std::vector<double> xyz = Numbers(*points, path);
-    if (xyz.size() % 3 != 0) throw InputError(ErrorCode::kParse, at, "<points> is not x y z triples");
+    if (xyz.size() % 3 != 0)
+        throw InputError(ErrorCode::kParse, at, "<points> is not x y z triples");
     for (std::size_t i = 0; i < xyz.size(); i += 3) {
         mesh->positions.push_back(kMetresPerOpfUnit * glm::dvec3(xyz[i], xyz[i + 1], xyz[i + 2]));
     }
@@ -225,8 +233,9 @@ void ReadNode(const XmlElement& element, NodeId parent, const glm::dmat4& worldF
             }
             if (const XmlElement* shape = child->Child("shapeIndex")) {
                 const std::vector<double> index = Numbers(*shape, context.path);
-                const auto found = index.size() == 1 ? context.shapes.find(static_cast<int>(index[0]))
-                                                     : context.shapes.end();
+                const auto found = index.size() == 1
+                                       ? context.shapes.find(static_cast<int>(index[0]))
+                                       : context.shapes.end();
                 if (found == context.shapes.end() || !context.meshes.count(found->second.first)) {
                     throw InputError(ErrorCode::kNotFound,
                                      context.path + ":" + std::to_string(shape->line),
@@ -235,9 +244,8 @@ void ReadNode(const XmlElement& element, NodeId parent, const glm::dmat4& worldF
                 node.organ = Organ{context.meshes.at(found->second.first),
                                    "material" + std::to_string(found->second.second)};
             }
-        } else if (child->name != "decomp" && child->name != "branch" &&
-                   child->name != "follow" && child->text.find_first_not_of(" \t\r\n") !=
-                                                   std::string::npos) {
+        } else if (child->name != "decomp" && child->name != "branch" && child->name != "follow" &&
+                   child->text.find_first_not_of(" \t\r\n") != std::string::npos) {
             // Attributes declared in attributeBDD: <Length>0.1</Length>.
             std::istringstream in(child->text);
             double value;
@@ -261,7 +269,8 @@ ImportedGeometry ReadOpfFile(const std::string& path) {
     std::stringstream buffer;
     buffer << in.rdbuf();
     const auto root = XmlReader(buffer.str(), path).Document();
-    if (root->name != "opf") throw InputError(ErrorCode::kParse, path, "the root element is not <opf>");
+    if (root->name != "opf")
+        throw InputError(ErrorCode::kParse, path, "the root element is not <opf>");
 
     OpfContext context;
     context.path = path;

@@ -40,7 +40,7 @@ NodeType TypeFromName(std::string name) {
 
 // Builds organs as faces arrive; vertices are shared file-wide, copied per organ.
 class ObjOrgans {
-public:
+  public:
     void Start(const std::string& group, const std::string& material) {
         group_ = group;
         material_ = material;
@@ -80,7 +80,7 @@ public:
     }
     std::vector<Node> Take() { return std::move(organs_); }
 
-private:
+  private:
     std::string Unique(const std::string& name) {
         const int seen = names_[name]++;
         return seen == 0 ? name : name + "#" + std::to_string(seen + 1);
@@ -125,12 +125,12 @@ ImportedGeometry ReadObj(const std::string& path) {
             while (fields >> corner) {
                 // v, v/vt, v//vn or v/vt/vn; negative indices count back from the end.
                 const int index = std::atoi(corner.c_str());
-                const int resolved = index < 0 ? static_cast<int>(vertices.size()) + index
-                                               : index - 1;
+                const int resolved =
+                    index < 0 ? static_cast<int>(vertices.size()) + index : index - 1;
                 if (index == 0 || resolved < 0 || resolved >= static_cast<int>(vertices.size())) {
-                    ParseError(path, line, "face refers to vertex " + corner +
-                                               ", not among the " +
-                                               std::to_string(vertices.size()) + " so far");
+                    ParseError(path, line,
+                               "face refers to vertex " + corner + ", not among the " +
+                                   std::to_string(vertices.size()) + " so far");
                 }
                 indices.push_back(resolved);
             }
@@ -158,7 +158,8 @@ ImportedGeometry ReadCan(const std::string& path) {
         std::istringstream fields(text);
         std::string keyword;
         if (!(fields >> keyword) || keyword[0] == '#') continue;
-        if (keyword != "p") ParseError(path, line, "expected 'p' (a polygon), got '" + keyword + "'");
+        if (keyword != "p")
+            ParseError(path, line, "expected 'p' (a polygon), got '" + keyword + "'");
         int attributes = 0;
         std::string label;
         if (!(fields >> attributes) || attributes < 1 || !(fields >> label)) {
@@ -175,7 +176,8 @@ ImportedGeometry ReadCan(const std::string& path) {
         const long plant = std::stol(label.substr(label.size() - 11, 5));
         const long organ = std::stol(label.substr(label.size() - 6, 3));
         int count = 0;
-        if (!(fields >> count) || count < 3) ParseError(path, line, "a polygon needs 3 or more vertices");
+        if (!(fields >> count) || count < 3)
+            ParseError(path, line, "a polygon needs 3 or more vertices");
         std::vector<glm::dvec3> polygon(count);
         for (glm::dvec3& v : polygon) {
             v.x = ReadNumber(fields, path, line, "x");

@@ -20,7 +20,8 @@ std::vector<StructureLight> AggregateStructures(const Scene& scene, const FlatSc
             StructureLight& s = sums[at];
             if (s.bands.empty()) {
                 s.bands.assign(bands, BandLight{});
-                for (BandLight& b : s.bands) b.stderrUpperWm2 = b.stderrLowerWm2 = b.stderrAbsorbedW = 0.0;
+                for (BandLight& b : s.bands)
+                    b.stderrUpperWm2 = b.stderrLowerWm2 = b.stderrAbsorbedW = 0.0;
             }
             ++s.organCount;
             s.areaM2 += receiver.areaM2;
@@ -34,9 +35,12 @@ std::vector<StructureLight> AggregateStructures(const Scene& scene, const FlatSc
                 sum.radianceIntegral += a * leaf.radianceIntegral;
                 sum.radianceMoment += a * leaf.radianceMoment;
                 const bool hasError = leaf.stderrUpperWm2 >= 0.0;
-                sum.stderrUpperWm2 = hasError ? sum.stderrUpperWm2 + std::pow(a * leaf.stderrUpperWm2, 2) : -1.0;
-                sum.stderrLowerWm2 = hasError ? sum.stderrLowerWm2 + std::pow(a * leaf.stderrLowerWm2, 2) : -1.0;
-                sum.stderrAbsorbedW = hasError ? sum.stderrAbsorbedW + std::pow(leaf.stderrAbsorbedW, 2) : -1.0;
+                sum.stderrUpperWm2 =
+                    hasError ? sum.stderrUpperWm2 + std::pow(a * leaf.stderrUpperWm2, 2) : -1.0;
+                sum.stderrLowerWm2 =
+                    hasError ? sum.stderrLowerWm2 + std::pow(a * leaf.stderrLowerWm2, 2) : -1.0;
+                sum.stderrAbsorbedW =
+                    hasError ? sum.stderrAbsorbedW + std::pow(leaf.stderrAbsorbedW, 2) : -1.0;
             }
         }
     }

@@ -1,9 +1,10 @@
 #include "solver/raytrace.h"
 
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+
 #include <cmath>
 #include <string>
-#include <xmmintrin.h>
-#include <pmmintrin.h>
 
 #include "solver/check.h"
 
@@ -15,8 +16,8 @@ namespace {
 constexpr int kMaxTileCrossings = 10000;
 
 // Periodic copies: index 0 is the tile itself, 1..8 its neighbours.
-constexpr int kCopyOffsets[9][2] = {{0, 0},  {1, 0},  {-1, 0}, {0, 1},  {0, -1},
-                                    {1, 1},  {1, -1}, {-1, 1}, {-1, -1}};
+constexpr int kCopyOffsets[9][2] = {{0, 0}, {1, 0},  {-1, 0}, {0, 1},  {0, -1},
+                                    {1, 1}, {1, -1}, {-1, 1}, {-1, -1}};
 
 int CopyIndex(int i, int j) {
     for (int k = 0; k < 9; ++k) {
@@ -66,8 +67,7 @@ RTCRay MakeRay(const RayStart& start, const glm::dvec3& direction, double tFar) 
     ray.dir_y = static_cast<float>(direction.y);
     ray.dir_z = static_cast<float>(direction.z);
     ray.tnear = 0.0f;
-    ray.tfar = std::isinf(tFar) ? std::numeric_limits<float>::infinity()
-                                : static_cast<float>(tFar);
+    ray.tfar = std::isinf(tFar) ? std::numeric_limits<float>::infinity() : static_cast<float>(tFar);
     ray.time = 0.0f;
     ray.mask = 0xFFFFFFFFu;
     ray.id = 0;
@@ -140,9 +140,18 @@ RayScene::RayScene(const FlatScene& flat, std::optional<PeriodicDomain> periodic
         RTCGeometry instance = rtcNewGeometry(rtc, RTC_GEOMETRY_TYPE_INSTANCE);
         rtcSetGeometryInstancedScene(instance, mesh_);
         // Column-major 3×4: identity rotation, then the copy's translation.
-        const float transform[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1,
+        const float transform[12] = {1,
+                                     0,
+                                     0,
+                                     0,
+                                     1,
+                                     0,
+                                     0,
+                                     0,
+                                     1,
                                      static_cast<float>(kCopyOffsets[k][0] * width),
-                                     static_cast<float>(kCopyOffsets[k][1] * depth), 0};
+                                     static_cast<float>(kCopyOffsets[k][1] * depth),
+                                     0};
         rtcSetGeometryTransform(instance, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, transform);
         rtcCommitGeometry(instance);
         rtcAttachGeometryByID(top_, instance, k);
@@ -156,8 +165,7 @@ RayScene::~RayScene() {
     if (mesh_) rtcReleaseScene(mesh_);
 }
 
-RayHit RayScene::TraceOnce(const RayStart& start, const glm::dvec3& direction,
-                           double tFar) const {
+RayHit RayScene::TraceOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const {
     StartContext context = MakeContext(start);
     RTCRayHit rayHit;
     rayHit.ray = MakeRay(start, direction, tFar);
@@ -176,8 +184,7 @@ RayHit RayScene::TraceOnce(const RayStart& start, const glm::dvec3& direction,
     return result;
 }
 
-bool RayScene::OccludedOnce(const RayStart& start, const glm::dvec3& direction,
-                            double tFar) const {
+bool RayScene::OccludedOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const {
     StartContext context = MakeContext(start);
     RTCRay ray = MakeRay(start, direction, tFar);
     rtcOccluded1(top_, &context.context, &ray);

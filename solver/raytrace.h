@@ -6,13 +6,13 @@
 // Nothing invalid reaches Embree: FlatScene comes from a validated Scene.
 #pragma once
 
+#include <embree3/rtcore.h>
+
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <limits>
 #include <memory>
 #include <optional>
-
-#include <embree3/rtcore.h>
-#include <glm/glm.hpp>
 
 #include "solver/geometry.h"
 
@@ -22,7 +22,7 @@ namespace leaflux {
 void SetFlushToZero();
 
 class RayDevice {
-public:
+  public:
     RayDevice();
     ~RayDevice();
     RayDevice(const RayDevice&) = delete;
@@ -32,7 +32,7 @@ public:
     // One device for the process; Embree devices are thread-safe.
     static std::shared_ptr<RayDevice> Shared();
 
-private:
+  private:
     RTCDevice device_;
 };
 
@@ -57,7 +57,7 @@ struct RayHit {
 };
 
 class RayScene {
-public:
+  public:
     // `periodic`: the tile, in the FlatScene's local frame, repeated in x and y. Geometry
     // may overhang the tile by less than one tile width.
     RayScene(const FlatScene& flat, std::optional<PeriodicDomain> periodic,
@@ -77,7 +77,7 @@ public:
     const FlatScene& Flat() const { return flat_; }
     bool Periodic() const { return periodic_.has_value(); }
 
-private:
+  private:
     RayHit TraceOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const;
     bool OccludedOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const;
     // Wraps a start into the tile; returns the distance to the tile's side along direction.

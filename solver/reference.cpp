@@ -1,5 +1,8 @@
 #include "solver/reference.h"
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -8,9 +11,6 @@
 #include <mutex>
 #include <numeric>
 #include <unordered_map>
-
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include "solver/check.h"
 #include "solver/memory.h"
@@ -29,8 +29,9 @@ using Spectrum = std::array<double, kMaxBands>;
 
 // Everything the paths need to know of the sources, prepared once per solve.
 class Lights {
-public:
-    Lights(const Scene& scene, const FlatScene& flat) : bands_(static_cast<int>(scene.bands.size())) {
+  public:
+    Lights(const Scene& scene, const FlatScene& flat)
+        : bands_(static_cast<int>(scene.bands.size())) {
         double total = 0.0;
         for (const Sun& sun : scene.sources.suns) {
             const double power = std::accumulate(sun.normalIrradianceWm2.begin(),
@@ -55,10 +56,11 @@ public:
             const Receiver& receiver = flat.receivers[r];
             if (receiver.kind != ReceiverKind::kEmitter) continue;
             const Emitter& emitter = scene.sources.emitters[receiver.emitter];
-            const double exitance = std::accumulate(emitter.exitanceWm2.begin(),
-                                                    emitter.exitanceWm2.end(), 0.0);
+            const double exitance =
+                std::accumulate(emitter.exitanceWm2.begin(), emitter.exitanceWm2.end(), 0.0);
+            // A dark lamp is still a surface, but nothing to sample.
             for (std::uint32_t t = receiver.firstTriangle;
-                 t < receiver.firstTriangle + receiver.triangleCount; ++t) {
+                 exitance > 0.0 && t < receiver.firstTriangle + receiver.triangleCount; ++t) {
                 emitted += exitance * flat.triangles[t].areaM2;
                 emitterTriangles_.push_back({t, emitted});
             }
@@ -87,10 +89,12 @@ public:
         std::size_t i = 0;
         while (i + 1 < suns_.size() && u >= suns_[i].cumulative) ++i;
         const double pick = suns_[i].cumulative - (i == 0 ? 0.0 : suns_[i - 1].cumulative);
-        for (int b = 0; b < bands_; ++b) irradiance[b] = suns_[i].sun->normalIrradianceWm2[b] / pick;
+        for (int b = 0; b < bands_; ++b)
+            irradiance[b] = suns_[i].sun->normalIrradianceWm2[b] / pick;
         const double v = random.Uniform(), w = random.Uniform();
-        return suns_[i].cosRadius < 1.0 ? UniformCone(suns_[i].sun->towardSun, suns_[i].cosRadius, v, w)
-                                        : suns_[i].sun->towardSun;
+        return suns_[i].cosRadius < 1.0
+                   ? UniformCone(suns_[i].sun->towardSun, suns_[i].cosRadius, v, w)
+                   : suns_[i].sun->towardSun;
     }
 
     // Sky radiance arriving from `towardSky`. A cone reaching below the horizon folds its
@@ -132,10 +136,10 @@ public:
     // Exitance (W/m²) of an emitter receiver's upper side; null for other receivers.
     const Spectrum* Exitance(std::uint32_t receiver) const {
         return receiver < isEmitter_.size() && isEmitter_[receiver] ? &exitance_[receiver]
-                                                                   : nullptr;
+                                                                    : nullptr;
     }
 
-private:
+  private:
     Spectrum ToSpectrum(const std::vector<double>& values) const {
         Spectrum s{};
         std::copy(values.begin(), values.end(), s.begin());
@@ -204,14 +208,14 @@ struct Tally {
     Spectrum direct[2]{};  // the part that came straight from a source
     Spectrum radianceIntegral{};
     std::array<glm::dvec3, kMaxBands> radianceMoment{};
-    double escape[2]{};    // cosine-weighted fraction of each side's view that escapes
+    double escape[2]{};  // cosine-weighted fraction of each side's view that escapes
 };
 
 // How the path tracer draws directions at a point, for the MIS weights of lamps.
 constexpr int kUniformSphere = -1;  // otherwise: cosine-weighted on side kUpper or kLower
 
 class PathTracer {
-public:
+  public:
     PathTracer(const Scene& scene, const FlatScene& flat, const RayScene& rays,
                const ReferenceOptions& options)
         : flat_(flat), rays_(rays), options_(options), lights_(scene, flat) {
@@ -285,7 +289,7 @@ public:
         return tally;
     }
 
-private:
+  private:
     // The point of the receiver at (u, v) of the unit square, area-preserving: u first
     // picks a triangle by area, and what is left of it places the point inside.
     RayStart PointOn(const Receiver& receiver, double u, double v) const {
@@ -344,8 +348,7 @@ private:
                 if (!rays_.Occluded(x, toward, distance * (1.0 - 1e-6))) {
                     const double pdfLight = y.pdfArea * distance * distance / cosEmitter;
                     const double weight =
-                        PowerHeuristic(pdfLight, DirectionPdf(sampling, normal, toward)) /
-                        pdfLight;
+                        PowerHeuristic(pdfLight, DirectionPdf(sampling, normal, toward)) / pdfLight;
                     Spectrum radiance = *lights_.Exitance(flat_.triangles[y.triangle].receiver);
                     for (int b = 0; b < bands; ++b) radiance[b] /= kPi;
                     add(toward, radiance, weight);
@@ -482,8 +485,8 @@ Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScen
             std::vector<std::array<std::vector<double>, 6>> series(bands);
             std::vector<Tally> tallies;
             for (int k = 0; k < options.replicates; ++k) {
-                tallies.push_back(tracer.Replicate(r, perReplicate,
-                                                   StreamSeed(options.seed, r, k), receiverRays));
+                tallies.push_back(tracer.Replicate(r, perReplicate, StreamSeed(options.seed, r, k),
+                                                   receiverRays));
             }
             for (int b = 0; b < bands; ++b) {
                 auto& [upper, lower, absorb, in, out, rest] = series[b];
@@ -510,7 +513,8 @@ Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScen
                     out.push_back(escapedW * receiver.areaM2);
                     rest.push_back((incidentW - absorbedW - escapedW) * receiver.areaM2);
                     light.radianceIntegral += t.radianceIntegral[b] / options.replicates;
-                    light.radianceMoment += t.radianceMoment[b] / static_cast<double>(options.replicates);
+                    light.radianceMoment +=
+                        t.radianceMoment[b] / static_cast<double>(options.replicates);
                 }
                 const Estimate up = Combine(upper), low = Combine(lower), abs = Combine(absorb);
                 light.irradianceUpperWm2 = up.mean;

@@ -26,9 +26,9 @@ struct ReferenceOptions {
     int samplesPerReceiver = 1024;  // paths per receiver, rounded up to replicates · m²
     int replicates = 16;            // independent groups for the standard error (≥ 2)
     std::uint64_t seed = 1;
-    int threads = 0;                // 0: every core
-    int maxDepth = 100000;          // a safety net: with Russian roulette at ≤ 0.995,
-                                    // a path reaches it with probability < 1e-200
+    int threads = 0;        // 0: every core
+    int maxDepth = 100000;  // a safety net: with Russian roulette at ≤ 0.995,
+                            // a path reaches it with probability < 1e-200
     // Called with the fraction done, from any thread, at most every 1 %.
     std::function<void(double)> progress;
 };

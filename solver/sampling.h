@@ -5,7 +5,6 @@
 
 #include <cmath>
 #include <cstdint>
-
 #include <glm/glm.hpp>
 #include <glm/gtc/constants.hpp>
 
@@ -25,7 +24,7 @@ inline std::uint64_t StreamSeed(std::uint64_t seed, std::uint64_t a, std::uint64
 
 // PCG32 (O'Neill 2014): small state, good statistics, one stream per seed.
 class Random {
-public:
+  public:
     explicit Random(std::uint64_t seed) : state_(0), increment_((seed << 1u) | 1u) {
         Next();
         state_ += MixBits(seed);
@@ -49,7 +48,7 @@ public:
     // Uniform integer in [0, n).
     std::uint32_t Below(std::uint32_t n) { return static_cast<std::uint32_t>(Uniform() * n); }
 
-private:
+  private:
     std::uint64_t state_;
     std::uint64_t increment_;
 };

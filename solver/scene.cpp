@@ -64,9 +64,8 @@ void ValidateMesh(const Mesh* mesh, const glm::dmat4& worldFromLocal, const std:
         const double twiceArea = glm::length(glm::cross(b - a, c - a));
         const double longest =
             std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
-        Require(twiceArea > 1e-9 * longest * longest && twiceArea > 1e-18,
-                ErrorCode::kDegenerate, at, "has zero area (collapsed or repeated vertices)",
-                node);
+        Require(twiceArea > 1e-9 * longest * longest && twiceArea > 1e-18, ErrorCode::kDegenerate,
+                at, "has zero area (collapsed or repeated vertices)", node);
     }
 }
 
@@ -77,9 +76,9 @@ void ValidateOptics(const Scene& scene) {
         Require(!optics.id.empty(), ErrorCode::kInvalidArgument, "optics.id", "is empty");
         Require(ids.insert(optics.id).second, ErrorCode::kAlreadyExists, field,
                 "is declared twice");
-        Require(optics.bands.size() == scene.bands.size(), ErrorCode::kNotFound, field + ".bands",
-                "needs properties for each of the " + std::to_string(scene.bands.size()) +
-                    " bands");
+        Require(
+            optics.bands.size() == scene.bands.size(), ErrorCode::kNotFound, field + ".bands",
+            "needs properties for each of the " + std::to_string(scene.bands.size()) + " bands");
         for (std::size_t b = 0; b < optics.bands.size(); ++b) {
             const BandOptics& o = optics.bands[b];
             const std::string at = field + ".bands[" + scene.bands[b].name + "]";
@@ -109,8 +108,8 @@ void ValidateTopology(const Scene& scene, std::set<std::string>& names) {
                 "the id is used by two nodes", node.id);
     }
     for (const Node& node : scene.nodes) {
-        Require(node.parent == kNoParent || byId.count(node.parent), ErrorCode::kNotFound,
-                "parent", "names unknown node " + std::to_string(node.parent), node.id);
+        Require(node.parent == kNoParent || byId.count(node.parent), ErrorCode::kNotFound, "parent",
+                "names unknown node " + std::to_string(node.parent), node.id);
         for (int c = 0; c < 4; ++c) {
             for (int r = 0; r < 4; ++r) {
                 Require(std::isfinite(node.parentFromLocal[c][r]), ErrorCode::kInvalidArgument,
@@ -171,7 +170,8 @@ void ValidateSources(const Scene& scene, std::set<std::string>& names) {
                 "emitters[" + std::to_string(i) + "].name", "is empty");
         ValidateMesh(emitter.mesh.get(), glm::dmat4(1.0), field + ".mesh", std::nullopt);
         RequirePerBand(scene, emitter.exitanceWm2, field + ".exitance");
-        if (!emitter.opticsId.empty()) RequireOptics(scene, emitter.opticsId, field + ".optics", {});
+        if (!emitter.opticsId.empty())
+            RequireOptics(scene, emitter.opticsId, field + ".optics", {});
         Require(names.insert(emitter.name).second, ErrorCode::kAlreadyExists, field + ".name",
                 "the name is used twice");
     }
@@ -181,13 +181,20 @@ void ValidateSources(const Scene& scene, std::set<std::string>& names) {
 
 const char* NodeTypeName(NodeType type) {
     switch (type) {
-        case NodeType::kPlant: return "plant";
-        case NodeType::kAxis: return "axis";
-        case NodeType::kPhytomer: return "phytomer";
-        case NodeType::kLeaf: return "leaf";
-        case NodeType::kInternode: return "internode";
-        case NodeType::kFruit: return "fruit";
-        case NodeType::kOther: return "other";
+        case NodeType::kPlant:
+            return "plant";
+        case NodeType::kAxis:
+            return "axis";
+        case NodeType::kPhytomer:
+            return "phytomer";
+        case NodeType::kLeaf:
+            return "leaf";
+        case NodeType::kInternode:
+            return "internode";
+        case NodeType::kFruit:
+            return "fruit";
+        case NodeType::kOther:
+            return "other";
     }
     return "other";
 }

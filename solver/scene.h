@@ -8,13 +8,12 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "solver/sources.h"
 
@@ -63,9 +62,9 @@ struct Node {
     NodeId id = 0;
     NodeId parent = kNoParent;
     NodeType type = NodeType::kOther;
-    std::string name;                      // empty: "node<id>"
-    glm::dmat4 parentFromLocal{1.0};       // affine; z along the structure's main axis
-    double age = 0.0;                      // physiological age
+    std::string name;                 // empty: "node<id>"
+    glm::dmat4 parentFromLocal{1.0};  // affine; z along the structure's main axis
+    double age = 0.0;                 // physiological age
     std::map<std::string, double> attributes;
     std::optional<Organ> organ;
 };
@@ -90,8 +89,8 @@ struct Scene {
     Sources sources;
     std::optional<PeriodicDomain> periodic;
 
-    int BandIndex(const std::string& name) const;          // -1 when absent
-    int OpticsIndex(const std::string& id) const;          // -1 when absent
+    int BandIndex(const std::string& name) const;  // -1 when absent
+    int OpticsIndex(const std::string& id) const;  // -1 when absent
     std::string NodeName(const Node& node) const;
 
     // Checks the invariant above; throws InputError naming the field or node otherwise.

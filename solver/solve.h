@@ -20,14 +20,14 @@ struct SolverSettings {
 // A scene prepared for solving: flattened and committed to the ray engine. Build it once
 // and solve it as often as needed (other seeds, other settings).
 class PreparedScene {
-public:
+  public:
     explicit PreparedScene(const Scene& scene);  // scene must be valid and outlive this
 
     const Scene& Source() const { return scene_; }
     const FlatScene& Flat() const { return flat_; }
     const RayScene& Rays() const { return *rays_; }
 
-private:
+  private:
     const Scene& scene_;
     FlatScene flat_;
     std::unique_ptr<RayScene> rays_;

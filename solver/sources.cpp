@@ -2,9 +2,8 @@
 
 #include <array>
 #include <cmath>
-#include <mutex>
-
 #include <glm/gtc/constants.hpp>
+#include <mutex>
 
 #include "solver/check.h"
 #include "solver/directions.h"
@@ -40,7 +39,7 @@ int TurtleCell(const glm::dvec3& d) {
 // Fibonacci lattice of the upper hemisphere (low discrepancy: cell solid angles to ~1e-4).
 struct CellIntegration {
     static constexpr int kPoints = 1 << 18;
-    std::vector<int> cellOfPoint;          // per lattice point
+    std::vector<int> cellOfPoint;  // per lattice point
     std::vector<glm::dvec3> pointDirections;
     std::vector<SkyCell> cells;
 };
@@ -114,10 +113,9 @@ const CellIntegration& CellsOf(SkyDiscretization discretization) {
 
 SolarAngles SolarPosition(double latitudeDeg, int dayOfYear, double solarTimeH) {
     const double gamma = 2.0 * kPi * (dayOfYear - 1) / 365.0;  // Spencer's day angle
-    const double declination = 0.006918 - 0.399912 * std::cos(gamma) +
-                               0.070257 * std::sin(gamma) - 0.006758 * std::cos(2 * gamma) +
-                               0.000907 * std::sin(2 * gamma) - 0.002697 * std::cos(3 * gamma) +
-                               0.00148 * std::sin(3 * gamma);
+    const double declination = 0.006918 - 0.399912 * std::cos(gamma) + 0.070257 * std::sin(gamma) -
+                               0.006758 * std::cos(2 * gamma) + 0.000907 * std::sin(2 * gamma) -
+                               0.002697 * std::cos(3 * gamma) + 0.00148 * std::sin(3 * gamma);
     const double hourAngle = glm::radians(15.0 * (solarTimeH - 12.0));
     const double latitude = glm::radians(latitudeDeg);
     const double sinElevation = std::sin(latitude) * std::sin(declination) +

@@ -3,11 +3,10 @@
 // All per-band values are in scene band order. World frame: x east, y north, z up.
 #pragma once
 
+#include <glm/glm.hpp>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 namespace leaflux {
 
@@ -15,9 +14,9 @@ struct Mesh;
 
 // A sun, possibly one of several weighted positions over a period.
 struct Sun {
-    glm::dvec3 towardSun{0.0, 0.0, 1.0};       // unit vector from the scene to the sun
-    std::vector<double> normalIrradianceWm2;   // on a plane facing the sun, per band
-    double angularRadiusRad = 0.0;             // 0: a point source, hard shadows
+    glm::dvec3 towardSun{0.0, 0.0, 1.0};      // unit vector from the scene to the sun
+    std::vector<double> normalIrradianceWm2;  // on a plane facing the sun, per band
+    double angularRadiusRad = 0.0;            // 0: a point source, hard shadows
 };
 
 struct SolarAngles {
@@ -76,9 +75,9 @@ std::vector<SkyCell> SkyCells(SkyDiscretization discretization);
 // A lamp or bright window: emits diffusely from the upper side of its triangles.
 struct Emitter {
     std::string name;
-    std::shared_ptr<const Mesh> mesh;      // world coordinates
-    std::vector<double> exitanceWm2;       // per band
-    std::string opticsId;                  // empty: black (absorbs all it receives)
+    std::shared_ptr<const Mesh> mesh;  // world coordinates
+    std::vector<double> exitanceWm2;   // per band
+    std::string opticsId;              // empty: black (absorbs all it receives)
 };
 
 struct Sources {

@@ -31,10 +31,12 @@ Scene RandomCanopy(int leaves, double lai, std::uint64_t seed, BandOptics leafOp
         const double spin = 2.0 * kPi * random.Uniform();
         const glm::dvec3 u = 0.5 * side * (std::cos(spin) * t + std::sin(spin) * b);
         const glm::dvec3 v = glm::cross(normal, u);
-        scene.nodes.push_back(OrganNode(i + 1, "leaf" + std::to_string(i + 1),
-                                        Quad(centre - u - v, centre + u - v, centre + u + v, centre - u + v), "leaf"));
+        scene.nodes.push_back(OrganNode(
+            i + 1, "leaf" + std::to_string(i + 1),
+            Quad(centre - u - v, centre + u - v, centre + u + v, centre - u + v), "leaf"));
     }
-    scene.environment.push_back({"ground", Quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}), "ground"});
+    scene.environment.push_back(
+        {"ground", Quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}), "ground"});
     return scene;
 }
 
@@ -90,7 +92,8 @@ TEST(RandomCanopy, GapAndSunlitFractionsMatchTheFiniteNLaw) {
     }
     const Statistics gap = Of(gaps), lit = Of(sunlit);
     EXPECT_NEAR(gap.mean, gapExpected, kTQuantile * gap.stderrValue) << "expected " << gapExpected;
-    EXPECT_NEAR(lit.mean, sunlitExpected, kTQuantile * lit.stderrValue) << "expected " << sunlitExpected;
+    EXPECT_NEAR(lit.mean, sunlitExpected, kTQuantile * lit.stderrValue)
+        << "expected " << sunlitExpected;
     // And the realisations are not so noisy that the check says nothing.
     EXPECT_LT(gap.stderrValue, 0.05 * gapExpected);
     EXPECT_LT(lit.stderrValue, 0.05 * sunlitExpected);
@@ -115,7 +118,8 @@ TEST(RandomCanopy, ConservesEnergyWhenLeavesScatterNinetyNinePercent) {
     // to a few percent, so the check above can fail.
     EXPECT_LT(e.stderrW, 0.05 * e.incidentW);
     for (const auto& light : solution.light) {
-        EXPECT_TRUE(std::isfinite(light[0].irradianceUpperWm2) && std::isfinite(light[0].irradianceLowerWm2));
+        EXPECT_TRUE(std::isfinite(light[0].irradianceUpperWm2) &&
+                    std::isfinite(light[0].irradianceLowerWm2));
     }
 }
 
@@ -149,7 +153,8 @@ TEST(Determinism, SameSeedSameResultWhateverTheThreads) {
 // filterT.can: three horizontal checkerboards of 50 % cover at z = 5, 10 and 15. Under a
 // vertical sun the layers are lit 1, 0.5 and 0.25 and the ground 0.125, exactly.
 TEST(FilterT, LayersAreLitOneHalfQuarterAndGroundEighth) {
-    const ImportedGeometry geometry = ReadCan(std::string(LEAFLUX_SHARED_DATA) + "/caribu/filterT.can");
+    const ImportedGeometry geometry =
+        ReadCan(std::string(LEAFLUX_SHARED_DATA) + "/caribu/filterT.can");
     Scene scene = OneBandScene({{"black", Leaf(0, 0)}});
     // The file is one organ; split it into its layers by height.
     auto layers = std::vector<std::shared_ptr<Mesh>>{};
@@ -170,8 +175,11 @@ TEST(FilterT, LayersAreLitOneHalfQuarterAndGroundEighth) {
             layer.triangles.push_back({first, first + 1, first + 2});
         }
     }
-    for (int l = 0; l < 3; ++l) scene.nodes.push_back(OrganNode(l + 1, "layer" + std::to_string(l), layers[l], "black"));
-    scene.environment.push_back({"ground", Quad({lo.x, lo.y, 0}, {hi.x, lo.y, 0}, {hi.x, hi.y, 0}, {lo.x, hi.y, 0}), "black"});
+    for (int l = 0; l < 3; ++l)
+        scene.nodes.push_back(OrganNode(l + 1, "layer" + std::to_string(l), layers[l], "black"));
+    scene.environment.push_back(
+        {"ground", Quad({lo.x, lo.y, 0}, {hi.x, lo.y, 0}, {hi.x, hi.y, 0}, {lo.x, hi.y, 0}),
+         "black"});
     scene.sources.suns.push_back({{0, 0, 1}, {1000.0}, 0.0});
     scene.Validate();
     const PreparedScene prepared(scene);

@@ -1,6 +1,7 @@
+#include "solver/directions.h"
+
 #include <gtest/gtest.h>
 
-#include "solver/directions.h"
 #include "solver/sampling.h"
 
 namespace leaflux {

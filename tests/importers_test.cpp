@@ -1,4 +1,6 @@
 // Every importer on the files of ../shared/data, and on broken files.
+#include "solver/importers.h"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -6,7 +8,6 @@
 #include <set>
 
 #include "solver/error.h"
-#include "solver/importers.h"
 #include "solver/scene.h"
 
 namespace leaflux {
@@ -22,7 +23,8 @@ std::string TemporaryFile(const std::string& name, const std::string& text) {
 
 int TriangleCount(const ImportedGeometry& g) {
     int count = 0;
-    for (const Node& node : g.nodes) count += node.organ ? static_cast<int>(node.organ->mesh->triangles.size()) : 0;
+    for (const Node& node : g.nodes)
+        count += node.organ ? static_cast<int>(node.organ->mesh->triangles.size()) : 0;
     return count;
 }
 
@@ -40,10 +42,11 @@ TEST(ReadObj, ReadsEachLeafPrototypeAsOneNamedOrgan) {
 }
 
 TEST(ReadObj, SplitsGroupsAndMaterials) {
-    const std::string path = TemporaryFile("groups.obj",
-        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
-        "g stem\nusemtl bark\nf 1 2 3\n"
-        "g blade\nusemtl green\nf 1 3 4\nusemtl yellow\nf -4 -3 -1\n");
+    const std::string path =
+        TemporaryFile("groups.obj",
+                      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                      "g stem\nusemtl bark\nf 1 2 3\n"
+                      "g blade\nusemtl green\nf 1 3 4\nusemtl yellow\nf -4 -3 -1\n");
     const ImportedGeometry g = ReadObj(path);
     ASSERT_EQ(g.nodes.size(), 3u);
     EXPECT_EQ(g.nodes[0].name, "stem");
@@ -84,11 +87,13 @@ TEST(ReadCan, DecodesLabelsOfTheSeedlingTray) {
 TEST(ReadCan, ReadsSoilAsEnvironment) {
     const ImportedGeometry g = ReadCan(Data("caribu/test.can"));
     ASSERT_EQ(g.environment.size(), 0u);  // test.can has no species-0 polygon
-    const ImportedGeometry s = ReadCan(TemporaryFile("soil.can", "p 1 000000000001 3 0 0 0 1 0 0 0 1 0\n"
-                                                                   "p 1 100001001001 3 0 0 1 1 0 1 0 1 1\n"));
+    const ImportedGeometry s = ReadCan(TemporaryFile("soil.can",
+                                                     "p 1 000000000001 3 0 0 0 1 0 0 0 1 0\n"
+                                                     "p 1 100001001001 3 0 0 1 1 0 1 0 1 1\n"));
     ASSERT_EQ(s.environment.size(), 1u);
     EXPECT_EQ(s.environment[0].opticsId, "soil");
-    EXPECT_THROW(ReadCan(TemporaryFile("badlabel.can", "p 1 12ab 3 0 0 0 1 0 0 0 1 0\n")), InputError);
+    EXPECT_THROW(ReadCan(TemporaryFile("badlabel.can", "p 1 12ab 3 0 0 0 1 0 0 0 1 0\n")),
+                 InputError);
 }
 
 TEST(ReadCanOptics, ReadsSoilAndSpecies) {
@@ -144,7 +149,11 @@ TEST(ReadOpf, KeepsSharedMeshesAndTheTopology) {
 
 TEST(ReadOpf, RejectsMalformedXml) {
     EXPECT_THROW(ReadOpf(TemporaryFile("bad.opf", "<opf><meshBDD></opf>")), InputError);
-    EXPECT_THROW(ReadOpf(TemporaryFile("nomesh.opf", "<opf><topology class=\"Scene\" id=\"1\"><geometry><shapeIndex>3</shapeIndex></geometry></topology></opf>")), InputError);
+    EXPECT_THROW(ReadOpf(TemporaryFile(
+                     "nomesh.opf",
+                     "<opf><topology class=\"Scene\" "
+                     "id=\"1\"><geometry><shapeIndex>3</shapeIndex></geometry></topology></opf>")),
+                 InputError);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
+#include "solver/raytrace.h"
+
 #include <gtest/gtest.h>
 
-#include "solver/raytrace.h"
 #include "tests/scene_builders.h"
 
 namespace leaflux {
@@ -66,7 +67,8 @@ TEST(RayScene, WrapsAroundAPeriodicTile) {
     // Up and out of the canopy: the sky.
     EXPECT_EQ(rays.Trace({flat.ToLocal({0.5, 0.5, 0.5})}, glm::normalize(glm::dvec3(3, 1, 1))).fate,
               RayFate::kEscapedUp);
-    EXPECT_FALSE(rays.Occluded({flat.ToLocal({0.5, 0.1, 0.5})}, glm::normalize(glm::dvec3(0, 1, 0.1))));
+    EXPECT_FALSE(
+        rays.Occluded({flat.ToLocal({0.5, 0.1, 0.5})}, glm::normalize(glm::dvec3(0, 1, 0.1))));
 }
 
 }  // namespace

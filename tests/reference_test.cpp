@@ -4,11 +4,12 @@
 // t with kReplicates − 1 degrees of freedom: kSigmas is its two-sided 1e-4 quantile. Where
 // geometry only approximates the closed form (a 256-gon for a disc) the bound adds that
 // error, stated.
+#include "solver/reference.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "solver/reference.h"
 #include "tests/scene_builders.h"
 
 namespace leaflux {
@@ -53,8 +54,7 @@ Solved Solve(const Scene& scene, int samples = 4096, std::uint64_t seed = 7, int
 }
 
 void ExpectWithin(double value, double expected, double stderrValue, double extra = 0.0) {
-    EXPECT_NEAR(value, expected,
-                kSigmas * stderrValue + kRounding * std::abs(expected) + extra)
+    EXPECT_NEAR(value, expected, kSigmas * stderrValue + kRounding * std::abs(expected) + extra)
         << "standard error " << stderrValue;
 }
 
@@ -130,8 +130,7 @@ std::vector<ViewFactorCase> ViewFactorCases() {
         {"perpendicular_1_2", p2e, p2r, 0.232853 / 2.0, 0},
         {"coaxial_discs_1_1_1", Disc(1, 0, false), Disc(1, 1, true), 0.381966, 1e-4},
         // F(r 0.2 → r 0.5) = 0.480032: E2 = M · F · (0.2/0.5)².
-        {"coaxial_discs_0.2_0.5", Disc(0.2, 0, false), Disc(0.5, 0.5, true), 0.480032 * 0.16,
-         1e-4},
+        {"coaxial_discs_0.2_0.5", Disc(0.2, 0, false), Disc(0.5, 0.5, true), 0.480032 * 0.16, 1e-4},
     };
 }
 
@@ -164,10 +163,11 @@ Scene Furnace(double rho, double exitance) {
     const int faces[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1},
                              {1, 5, 6, 2}, {2, 6, 7, 3}, {3, 7, 4, 0}};
     for (int f = 0; f < 6; ++f) {
-        scene.sources.emitters.push_back({"face" + std::to_string(f),
-                                          Quad(p[faces[f][0]], p[faces[f][1]], p[faces[f][2]],
-                                               p[faces[f][3]]),
-                                          {exitance}, "wall"});
+        scene.sources.emitters.push_back(
+            {"face" + std::to_string(f),
+             Quad(p[faces[f][0]], p[faces[f][1]], p[faces[f][2]], p[faces[f][3]]),
+             {exitance},
+             "wall"});
     }
     return scene;
 }

@@ -1,11 +1,10 @@
 // Small scenes with known answers, shared by the tests.
 #pragma once
 
+#include <glm/gtc/constants.hpp>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <glm/gtc/constants.hpp>
 
 #include "solver/scene.h"
 
@@ -22,8 +21,10 @@ inline std::shared_ptr<const Mesh> Quad(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c
 }
 
 // A horizontal w × h rectangle centred on (0, 0, z); upper side up, or down if `facingDown`.
-inline std::shared_ptr<const Mesh> Rectangle(double w, double h, double z, bool facingDown = false) {
-    const glm::dvec3 a(-w / 2, -h / 2, z), b(w / 2, -h / 2, z), c(w / 2, h / 2, z), d(-w / 2, h / 2, z);
+inline std::shared_ptr<const Mesh> Rectangle(double w, double h, double z,
+                                             bool facingDown = false) {
+    const glm::dvec3 a(-w / 2, -h / 2, z), b(w / 2, -h / 2, z), c(w / 2, h / 2, z),
+        d(-w / 2, h / 2, z);
     return facingDown ? Quad(a, d, c, b) : Quad(a, b, c, d);
 }
 
@@ -55,7 +56,7 @@ inline Scene OneBandScene(std::vector<std::pair<std::string, BandOptics>> optics
 }
 
 inline Node OrganNode(NodeId id, const std::string& name, std::shared_ptr<const Mesh> mesh,
-                  const std::string& optics, NodeId parent = kNoParent) {
+                      const std::string& optics, NodeId parent = kNoParent) {
     Node node;
     node.id = id;
     node.parent = parent;
@@ -68,7 +69,8 @@ inline Node OrganNode(NodeId id, const std::string& name, std::shared_ptr<const 
 inline Sun SunAt(double elevationDeg, double azimuthDeg, double irradiance) {
     const double h = glm::radians(elevationDeg), a = glm::radians(azimuthDeg);
     return {glm::dvec3(std::cos(h) * std::sin(a), std::cos(h) * std::cos(a), std::sin(h)),
-            {irradiance}, 0.0};
+            {irradiance},
+            0.0};
 }
 
 }  // namespace leaflux::testing

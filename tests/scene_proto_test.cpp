@@ -1,12 +1,13 @@
 // Scene files: the text format round-trips, imports resolve, and every schema-level
 // mistake is an InputError naming the field (or file line and column).
+#include "server/scene_proto.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
 #include <set>
 
-#include "server/scene_proto.h"
 #include "solver/error.h"
 #include "solver/generator.h"
 
@@ -66,7 +67,8 @@ TEST(SceneFile, RoundTripsAGeneratedTreeKeepingSharedMeshes) {
         EXPECT_EQ(back.nodes[i].type, scene.nodes[i].type);
         for (int c = 0; c < 4; ++c) {
             for (int r = 0; r < 4; ++r) {
-                EXPECT_DOUBLE_EQ(back.nodes[i].parentFromLocal[c][r], scene.nodes[i].parentFromLocal[c][r]);
+                EXPECT_DOUBLE_EQ(back.nodes[i].parentFromLocal[c][r],
+                                 scene.nodes[i].parentFromLocal[c][r]);
             }
         }
         if (back.nodes[i].organ) meshes.insert(back.nodes[i].organ->mesh.get());
@@ -77,12 +79,19 @@ TEST(SceneFile, RoundTripsAGeneratedTreeKeepingSharedMeshes) {
 
 TEST(SceneFile, ImportsCaribuWithItsOptics) {
     const std::string data = LEAFLUX_SHARED_DATA;
-    const Scene scene = LoadSceneFile(Write("bac1.scene.txtpb", R"(
+    const Scene scene = LoadSceneFile(Write(
+        "bac1.scene.txtpb",
+        R"(
 bands { name: "PAR" } bands { name: "NIR" }
-imports { path: ")" + data + R"(/caribu/bac1.can"
-          can_optics { key: "PAR" value: ")" + data + R"(/caribu/par.opt" }
-          can_optics { key: "NIR" value: ")" + data + R"(/caribu/nir.opt" } }
-can_lights { path: ")" + data + R"(/caribu/Turtle46soc.light" scale { key: "PAR" value: 100 } scale { key: "NIR" value: 80 } }
+imports { path: ")" +
+            data + R"(/caribu/bac1.can"
+          can_optics { key: "PAR" value: ")" +
+            data + R"(/caribu/par.opt" }
+          can_optics { key: "NIR" value: ")" +
+            data + R"(/caribu/nir.opt" } }
+can_lights { path: ")" +
+            data +
+            R"(/caribu/Turtle46soc.light" scale { key: "PAR" value: 100 } scale { key: "NIR" value: 80 } }
 )"));
     EXPECT_EQ(scene.sources.suns.size(), 46u);
     EXPECT_GE(scene.optics.size(), 5u);  // soil, two species and their stems
@@ -94,12 +103,16 @@ can_lights { path: ")" + data + R"(/caribu/Turtle46soc.light" scale { key: "PAR"
 
 TEST(SceneFile, ImportsObjAndOpfWithMaterialMaps) {
     const std::string data = LEAFLUX_SHARED_DATA;
-    const Scene scene = LoadSceneFile(Write("mixed.scene.txtpb", std::string(kHeader) + R"(
+    const Scene scene = LoadSceneFile(
+        Write("mixed.scene.txtpb",
+              std::string(kHeader) + R"(
 optics { id: "bark" bands { key: "PAR" value { rho_upper: 0.2 rho_lower: 0.2 } } }
 nodes { id: 1 type: NODE_TYPE_PLANT name: "plant" }
-imports { path: ")" + data + R"(/leaves/RedbudLeaf.obj" default_optics: "leaf" parent: 1 id_offset: 100
+imports { path: ")" +
+                  data + R"(/leaves/RedbudLeaf.obj" default_optics: "leaf" parent: 1 id_offset: 100
           frame { m: [0.1, 0, 0, 1,  0, 0.1, 0, 0,  0, 0, 0.1, 0.5] } }
-imports { path: ")" + data + R"(/opf/simple_plant.opf" id_offset: 1000
+imports { path: ")" +
+                  data + R"(/opf/simple_plant.opf" id_offset: 1000
           material_optics { key: "material0" value: "bark" } material_optics { key: "material1" value: "leaf" } }
 )"));
     EXPECT_EQ(scene.nodes.size(), 1u + 1u + 7u);
@@ -116,28 +129,46 @@ struct BadFile {
 TEST(SceneFile, NamesTheFieldOfEveryMistake) {
     const std::string header = kHeader;
     const BadFile cases[] = {
-        {"bands { name: \"PAR\" } nodes { id: 1 frame { m: [1, 2, 3] } }", ErrorCode::kInvalidArgument, "frame"},
+        {"bands { name: \"PAR\" } nodes { id: 1 frame { m: [1, 2, 3] } }",
+         ErrorCode::kInvalidArgument, "frame"},
         {"bands { nme: \"PAR\" }", ErrorCode::kParse, ":1:"},
-        {"bands { name: \"PAR\" } optics { id: \"x\" bands { key: \"UV\" value { } } }", ErrorCode::kNotFound, "optics[x].bands[UV]"},
+        {"bands { name: \"PAR\" } optics { id: \"x\" bands { key: \"UV\" value { } } }",
+         ErrorCode::kNotFound, "optics[x].bands[UV]"},
         {"bands { name: \"PAR\" } optics { id: \"x\" }", ErrorCode::kNotFound, "optics[x].bands"},
-        {"bands { name: \"PAR\" } nodes { id: 4 organ { mesh_ref: \"nope\" optics: \"x\" } }", ErrorCode::kNotFound, "organ.mesh_ref"},
-        {"bands { name: \"PAR\" } nodes { id: 4 organ { optics: \"x\" mesh { positions: [0, 0] } } }", ErrorCode::kInvalidArgument, "organ.mesh.positions"},
-        {"bands { name: \"PAR\" } suns { direction { } normal_irradiance { key: \"PAR\" value: 1 } }", ErrorCode::kInvalidArgument, "suns[0].direction"},
-        {"bands { name: \"PAR\" } suns { direction { z: 1 } }", ErrorCode::kNotFound, "suns[0].normal_irradiance"},
-        {"bands { name: \"PAR\" } suns { solar { latitude_deg: 95 day_of_year: 1 } normal_irradiance { key: \"PAR\" value: 1 } }", ErrorCode::kInvalidArgument, "suns[0].solar.latitude_deg"},
-        {"bands { name: \"PAR\" } sun_periods { latitude_deg: 10 day_of_year: 5 start_h: 10 end_h: 8 step_h: 1 }", ErrorCode::kInvalidArgument, "sun_periods[0]"},
-        {"bands { name: \"PAR\" } sky { horizontal_irradiance { key: \"NIR\" value: 3 } }", ErrorCode::kNotFound, "sky.horizontal_irradiance[NIR]"},
-        {"bands { name: \"PAR\" } imports { path: \"plant.xyz\" }", ErrorCode::kUnsupported, "imports[0].path"},
-        {"bands { name: \"PAR\" } imports { path: \"missing.obj\" }", ErrorCode::kIo, "missing.obj"},
+        {"bands { name: \"PAR\" } nodes { id: 4 organ { mesh_ref: \"nope\" optics: \"x\" } }",
+         ErrorCode::kNotFound, "organ.mesh_ref"},
+        {"bands { name: \"PAR\" } nodes { id: 4 organ { optics: \"x\" mesh { positions: [0, 0] } } "
+         "}",
+         ErrorCode::kInvalidArgument, "organ.mesh.positions"},
+        {"bands { name: \"PAR\" } suns { direction { } normal_irradiance { key: \"PAR\" value: 1 } "
+         "}",
+         ErrorCode::kInvalidArgument, "suns[0].direction"},
+        {"bands { name: \"PAR\" } suns { direction { z: 1 } }", ErrorCode::kNotFound,
+         "suns[0].normal_irradiance"},
+        {"bands { name: \"PAR\" } suns { solar { latitude_deg: 95 day_of_year: 1 } "
+         "normal_irradiance { key: \"PAR\" value: 1 } }",
+         ErrorCode::kInvalidArgument, "suns[0].solar.latitude_deg"},
+        {"bands { name: \"PAR\" } sun_periods { latitude_deg: 10 day_of_year: 5 start_h: 10 end_h: "
+         "8 step_h: 1 }",
+         ErrorCode::kInvalidArgument, "sun_periods[0]"},
+        {"bands { name: \"PAR\" } sky { horizontal_irradiance { key: \"NIR\" value: 3 } }",
+         ErrorCode::kNotFound, "sky.horizontal_irradiance[NIR]"},
+        {"bands { name: \"PAR\" } imports { path: \"plant.xyz\" }", ErrorCode::kUnsupported,
+         "imports[0].path"},
+        {"bands { name: \"PAR\" } imports { path: \"missing.obj\" }", ErrorCode::kIo,
+         "missing.obj"},
         {"version: 7 bands { name: \"PAR\" }", ErrorCode::kUnsupported, "version"},
     };
     for (const BadFile& c : cases) {
         const InputError e = ErrorOf(c.text);
         EXPECT_EQ(e.Code(), c.code) << c.text << "\n" << e.what();
-        EXPECT_NE(std::string(e.what()).find(c.field), std::string::npos) << c.text << "\n" << e.what();
+        EXPECT_NE(std::string(e.what()).find(c.field), std::string::npos) << c.text << "\n"
+                                                                          << e.what();
     }
     // And the solver's own validation runs on what the file builds.
-    const InputError e = ErrorOf(header + R"(nodes { id: 1 organ { optics: "leaf" mesh { positions: [0, 0, 0, 1, 0, 0, 2, 0, 0] triangles: [0, 1, 2] } } })");
+    const InputError e = ErrorOf(
+        header +
+        R"(nodes { id: 1 organ { optics: "leaf" mesh { positions: [0, 0, 0, 1, 0, 0, 2, 0, 0] triangles: [0, 1, 2] } } })");
     EXPECT_EQ(e.Code(), ErrorCode::kDegenerate);
     EXPECT_EQ(e.Node(), 1u);
 }

@@ -1,10 +1,9 @@
+#include "solver/sources.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
 #include <glm/gtc/constants.hpp>
-
-#include "solver/sources.h"
 
 namespace leaflux {
 namespace {
@@ -47,7 +46,8 @@ double HorizontalIrradiance(const Sky& sky) {
     for (int i = 0; i < steps; ++i) {
         const double theta = (i + 0.5) * (kPi / 2) / steps;
         const glm::dvec3 d(std::sin(theta), 0.0, std::cos(theta));
-        total += sky.Radiance(0, d) * std::cos(theta) * std::sin(theta) * 2 * kPi * (kPi / 2) / steps;
+        total +=
+            sky.Radiance(0, d) * std::cos(theta) * std::sin(theta) * 2 * kPi * (kPi / 2) / steps;
     }
     return total;
 }

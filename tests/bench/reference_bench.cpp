@@ -35,9 +35,13 @@ Run Measure(const PreparedScene& prepared, int samples, double sunIrradiance) {
         relative.push_back(std::hypot(nir.stderrUpperWm2, nir.stderrLowerWm2) / e);
     }
     std::nth_element(relative.begin(), relative.begin() + relative.size() / 2, relative.end());
-    return {samples, solution.stats.wallSeconds, solution.stats.cpuSeconds,
-            relative.empty() ? 0.0 : relative[relative.size() / 2], relative.size(),
-            solution.stats.rays, solution.stats.peakRssBytes};
+    return {samples,
+            solution.stats.wallSeconds,
+            solution.stats.cpuSeconds,
+            relative.empty() ? 0.0 : relative[relative.size() / 2],
+            relative.size(),
+            solution.stats.rays,
+            solution.stats.peakRssBytes};
 }
 
 }  // namespace
@@ -48,7 +52,9 @@ int main(int argc, char** argv) {
     const double sun = 500.0;
     Scene scene;
     scene.bands = {{"NIR", 700, 2500}};
-    scene.optics = {{"leaf", {{0.45, 0.45, 0.45, 0.45}}}, {"stem", {{0.4, 0.4, 0, 0}}}, {"ground", {{0.3, 0.3, 0, 0}}}};
+    scene.optics = {{"leaf", {{0.45, 0.45, 0.45, 0.45}}},
+                    {"stem", {{0.4, 0.4, 0, 0}}},
+                    {"ground", {{0.3, 0.3, 0, 0}}}};
     PlantationParameters plantation;
     plantation.tree.leafCount = 10000;
     plantation.tree.seed = 3;
@@ -69,15 +75,18 @@ int main(int argc, char** argv) {
 
     const char* path = argc > 1 ? argv[1] : "reference_bench.csv";
     std::ofstream csv(path);
-    csv << "scene,leaves,samples_per_leaf,wall_s,cpu_s,median_rel_stderr,lit_leaves,rays,peak_rss_mib\n";
+    csv << "scene,leaves,samples_per_leaf,wall_s,cpu_s,median_rel_stderr,lit_leaves,rays,peak_rss_"
+           "mib\n";
     std::printf("%-28s %8s %9s %8s %8s %10s %6s %12s %9s\n", "scene", "leaves", "samples", "wall_s",
                 "cpu_s", "median_err", "lit", "rays", "peak_MiB");
     for (const Run& r : runs) {
-        csv << "tree_10k_nir_sun_sky,10000," << r.samples << ',' << r.seconds << ',' << r.cpuSeconds << ','
-            << r.medianRelativeError << ',' << r.litLeaves << ',' << r.rays << ',' << r.peakRss / (1 << 20) << '\n';
-        std::printf("%-28s %8d %9d %8.2f %8.2f %9.3f%% %6zu %12lld %9lld\n", "tree_10k_nir_sun_sky", 10000,
-                    r.samples, r.seconds, r.cpuSeconds, 100 * r.medianRelativeError, r.litLeaves,
-                    static_cast<long long>(r.rays), static_cast<long long>(r.peakRss / (1 << 20)));
+        csv << "tree_10k_nir_sun_sky,10000," << r.samples << ',' << r.seconds << ',' << r.cpuSeconds
+            << ',' << r.medianRelativeError << ',' << r.litLeaves << ',' << r.rays << ','
+            << r.peakRss / (1 << 20) << '\n';
+        std::printf("%-28s %8d %9d %8.2f %8.2f %9.3f%% %6zu %12lld %9lld\n", "tree_10k_nir_sun_sky",
+                    10000, r.samples, r.seconds, r.cpuSeconds, 100 * r.medianRelativeError,
+                    r.litLeaves, static_cast<long long>(r.rays),
+                    static_cast<long long>(r.peakRss / (1 << 20)));
     }
     std::printf("wrote %s\n", path);
     return 0;
