@@ -20,6 +20,8 @@ namespace {
 struct SolveCommand {
     std::string scene, solver = "mc", out, structures, ply;
     int samples = 1024, replicates = 16, threads = 0;
+    double epsilon = 1e-4;
+    int subdivision = 3, visibilityRays = 8, directionLevel = 2;
     std::uint64_t seed = 1;
     bool quiet = false;
 };
@@ -33,6 +35,12 @@ int RunSolve(const SolveCommand& command) {
     settings.monteCarlo.replicates = command.replicates;
     settings.monteCarlo.seed = command.seed;
     settings.monteCarlo.threads = command.threads;
+    settings.kind = command.solver == "hrc" ? SolverKind::kHrc : SolverKind::kMonteCarlo;
+    settings.hrc.epsilon = command.epsilon;
+    settings.hrc.threads = command.threads;
+    settings.hrc.maxSubdivision = command.subdivision;
+    settings.hrc.visibilityRays = command.visibilityRays;
+    settings.hrc.directionLevel = command.directionLevel;
     if (!command.quiet) {
         spdlog::info(
             "{}: {} receivers, {} triangles, {} bands; loaded in {:.2f} s", command.scene,
@@ -124,8 +132,28 @@ int main(int argc, char** argv) {
         ->add_option("--scene", solve.scene, "Scene file (protobuf text format, leaflux.v1.Scene)")
         ->required()
         ->check(CLI::ExistingFile);
-    solveApp->add_option("--solver", solve.solver, "Solver: mc (Monte Carlo reference)")
-        ->check(CLI::IsMember({"mc"}));
+    solveApp
+        ->add_option(
+            "--solver", solve.solver,
+            "Solver: mc (Monte Carlo reference) or hrc (hierarchical radiosity with clustering)")
+        ->check(CLI::IsMember({"mc", "hrc"}));
+    solveApp
+        ->add_option(
+            "--epsilon", solve.epsilon,
+            "hrc: largest error of a link, as a fraction of the power the sources bring in")
+        ->check(CLI::Range(1e-9, 1.0));
+    solveApp
+        ->add_option("--subdivision", solve.subdivision,
+                     "hrc: times a triangle may be split in four")
+        ->check(CLI::Range(0, 8));
+    solveApp
+        ->add_option("--visibility-rays", solve.visibilityRays,
+                     "hrc: rays estimating each link's visibility")
+        ->check(CLI::Range(1, 1024));
+    solveApp
+        ->add_option("--direction-level", solve.directionLevel,
+                     "hrc: direction set of cluster light, 0..4 (4, 10, 34, 130, 514 directions)")
+        ->check(CLI::Range(0, 4));
     solveApp
         ->add_option("--samples", solve.samples, "mc: paths per receiver (standard error ~ 1/sqrt)")
         ->check(CLI::Range(2, 1 << 26));

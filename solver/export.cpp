@@ -93,6 +93,10 @@ std::string Summary(const std::string& solver, const Scene& scene, const FlatSce
          << " bands in " << Number(stats.wallSeconds) << " s (cpu " << Number(stats.cpuSeconds)
          << " s, " << stats.threads << " threads), peak " << stats.peakRssBytes / (1 << 20)
          << " MiB, " << stats.rays << " rays";
+    if (stats.links > 0) {
+        text << ", " << stats.links << " links, " << stats.elements << " elements, "
+             << stats.iterations << " iterations, residual " << Number(stats.residual);
+    }
     for (std::size_t b = 0; b < solution.balance.size(); ++b) {
         const EnergyBalance& e = solution.balance[b];
         text << "; " << scene.bands[b].name << ": incident " << Number(e.incidentW)

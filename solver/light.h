@@ -50,6 +50,11 @@ struct SolveStats {
     std::int64_t peakRssBytes = 0;
     std::int64_t rays = 0;
     int threads = 0;
+    // Deterministic solvers: the hierarchy and the iteration.
+    std::int64_t links = 0;
+    std::int64_t elements = 0;
+    int iterations = 0;
+    double residual = 0.0;  // last relative change of the radiosity
 };
 
 struct Solution {

@@ -20,6 +20,8 @@ Solution Solve(const PreparedScene& prepared, const SolverSettings& settings) {
         case SolverKind::kMonteCarlo:
             return SolveReference(prepared.Source(), prepared.Flat(), prepared.Rays(),
                                   settings.monteCarlo);
+        case SolverKind::kHrc:
+            return SolveHrc(prepared.Source(), prepared.Flat(), prepared.Rays(), settings.hrc);
     }
     return {};
 }

@@ -5,16 +5,18 @@
 #include <string>
 
 #include "solver/light.h"
+#include "solver/radiosity/hrc.h"
 #include "solver/raytrace.h"
 #include "solver/reference.h"
 
 namespace leaflux {
 
-enum class SolverKind { kMonteCarlo };
+enum class SolverKind { kMonteCarlo, kHrc };
 
 struct SolverSettings {
     SolverKind kind = SolverKind::kMonteCarlo;
     ReferenceOptions monteCarlo;
+    HrcOptions hrc;
 };
 
 // A scene prepared for solving: flattened and committed to the ray engine. Build it once

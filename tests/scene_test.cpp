@@ -235,7 +235,9 @@ TEST_P(RejectsBadInput, WithTypedErrorNamingTheField) {
     } catch (const InputError& e) {
         EXPECT_EQ(e.Code(), bad.code) << e.what();
         EXPECT_NE(e.Field().find(bad.field), std::string::npos) << e.what();
-        if (bad.node) EXPECT_EQ(e.Node(), bad.node) << e.what();
+        if (bad.node) {
+            EXPECT_EQ(e.Node(), bad.node) << e.what();
+        }
     }
 }
 

@@ -1,0 +1,28 @@
+// Point-to-polygon form factors (Lambert's contour formula), bounded in the near field:
+// the differential element at x, normal n, sees the polygon as F ∈ [0, 1] of its
+// cosine-weighted hemisphere, whatever the distance — never the 1/r² point formula that
+// exceeds 1 when elements nearly touch (Howell's catalogue, case B-5 generalised).
+#pragma once
+
+#include <glm/glm.hpp>
+#include <vector>
+
+namespace leaflux {
+
+struct SidedFormFactor {
+    double upper = 0.0;         // towards +n
+    double lower = 0.0;         // towards −n
+    double solidAngleSr = 0.0;  // of the polygon seen from x, both sides
+};
+
+// Form factors from the point x (unit normal n) to the triangle a, b, c, for each side of
+// x: the triangle is clipped by the plane of x and each part seen by its side.
+SidedFormFactor PointToTriangle(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3& a,
+                                const glm::dvec3& b, const glm::dvec3& c);
+
+// F from a differential element at x (normal n) to the polygon lying entirely on the +n
+// side of x's plane.
+double PointToPolygonAbove(const glm::dvec3& x, const glm::dvec3& n,
+                           const std::vector<glm::dvec3>& polygon);
+
+}  // namespace leaflux

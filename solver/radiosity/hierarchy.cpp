@@ -1,0 +1,239 @@
+#include "solver/radiosity/hierarchy.h"
+
+#include <algorithm>
+#include <limits>
+#include <unordered_map>
+
+#include "solver/check.h"
+
+namespace leaflux {
+
+Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat) : flat_(flat) {
+    // Receivers first: one patch per triangle, grouped when an organ has several.
+    std::vector<std::uint32_t> receiverNode(flat.receivers.size(), kNoNode);
+    for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
+        const Receiver& receiver = flat.receivers[r];
+        std::vector<std::uint32_t> patches;
+        for (std::uint32_t t = 0; t < receiver.triangleCount; ++t) {
+            patches.push_back(AddPatch(receiver.firstTriangle + t));
+        }
+        receiverNode[r] = patches.size() == 1 ? patches[0] : Constrain(std::move(patches));
+    }
+    // The botanical topology above the organs, single-child levels collapsed.
+    std::unordered_map<NodeId, std::vector<NodeId>> childrenOf;
+    std::unordered_map<NodeId, std::uint32_t> organOf;
+    for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
+        if (flat.receivers[r].kind == ReceiverKind::kOrgan)
+            organOf[flat.receivers[r].node] = receiverNode[r];
+    }
+    std::vector<NodeId> roots;
+    for (const Node& node : scene.nodes) {
+        (node.parent == kNoParent ? roots : childrenOf[node.parent]).push_back(node.id);
+    }
+    // Depth-first, children before parents, without recursion (trees may be deep).
+    std::unordered_map<NodeId, std::uint32_t> built;
+    std::vector<std::pair<NodeId, bool>> stack;
+    for (NodeId root : roots) stack.push_back({root, false});
+    while (!stack.empty()) {
+        auto [id, expanded] = stack.back();
+        stack.pop_back();
+        if (!expanded) {
+            stack.push_back({id, true});
+            for (NodeId child : childrenOf[id]) stack.push_back({child, false});
+            continue;
+        }
+        std::vector<std::uint32_t> parts;
+        if (const auto it = organOf.find(id); it != organOf.end()) parts.push_back(it->second);
+        for (NodeId child : childrenOf[id]) {
+            if (const auto it = built.find(child); it != built.end()) parts.push_back(it->second);
+        }
+        if (parts.empty()) continue;
+        built[id] = parts.size() == 1 ? parts[0] : Constrain(std::move(parts));
+    }
+    std::vector<std::uint32_t> top;
+    for (NodeId root : roots) {
+        if (const auto it = built.find(root); it != built.end()) top.push_back(it->second);
+    }
+    for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
+        if (flat.receivers[r].kind != ReceiverKind::kOrgan) top.push_back(receiverNode[r]);
+    }
+    if (top.empty()) return;
+    root_ = top.size() == 1 ? top[0] : Constrain(std::move(top));
+    cumulativeArea_.push_back(0.0);
+    Finish(root_);
+}
+
+std::uint32_t Hierarchy::AddPatch(std::uint32_t triangle) {
+    const Triangle& t = flat_.triangles[triangle];
+    HrcNode node;
+    node.patch = true;
+    node.a = t.a, node.b = t.b, node.c = t.c, node.normal = t.normal;
+    node.triangle = triangle;
+    node.receiver = t.receiver;
+    nodes_.push_back(node);
+    return static_cast<std::uint32_t>(nodes_.size() - 1);
+}
+
+std::uint32_t Hierarchy::AddCluster(std::vector<std::uint32_t> children) {
+    const auto index = static_cast<std::uint32_t>(nodes_.size());
+    for (std::uint32_t child : children) nodes_[child].parent = index;
+    HrcNode node;
+    node.children = std::move(children);
+    nodes_.push_back(std::move(node));
+    return index;
+}
+
+std::uint32_t Hierarchy::Constrain(std::vector<std::uint32_t> children) {
+    if (children.size() <= static_cast<std::size_t>(kMaxChildren))
+        return AddCluster(std::move(children));
+    // Median split along the widest axis of the children's centres, until each group fits.
+    auto centreOf = [&](std::uint32_t n) {
+        const HrcNode& node = nodes_[n];
+        if (node.patch) return (node.a + node.b + node.c) / 3.0;
+        glm::dvec3 sum(0.0);
+        std::vector<std::uint32_t> stack = {n};
+        int count = 0;
+        while (!stack.empty()) {  // mean of the patch centres below: clusters are small here
+            const HrcNode& at = nodes_[stack.back()];
+            stack.pop_back();
+            if (at.patch) {
+                sum += (at.a + at.b + at.c) / 3.0;
+                ++count;
+                if (count > 64) break;
+            }
+            stack.insert(stack.end(), at.children.begin(), at.children.end());
+        }
+        return count ? sum / static_cast<double>(count) : glm::dvec3(0.0);
+    };
+    std::vector<std::pair<glm::dvec3, std::uint32_t>> items;
+    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    for (std::uint32_t child : children) {
+        items.push_back({centreOf(child), child});
+        lo = glm::min(lo, items.back().first);
+        hi = glm::max(hi, items.back().first);
+    }
+    const glm::dvec3 extent = hi - lo;
+    const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0
+                     : extent.y >= extent.z                       ? 1
+                                                                  : 2;
+    // Split into kMaxChildren groups of equal size along the axis (one level of an
+    // octree-like split), each constrained again.
+    std::sort(items.begin(), items.end(), [axis](const auto& p, const auto& q) {
+        return p.first[axis] < q.first[axis] ||
+               (p.first[axis] == q.first[axis] && p.second < q.second);
+    });
+    std::vector<std::uint32_t> groups;
+    const std::size_t parts =
+        std::min<std::size_t>(kMaxChildren, (items.size() + kMaxChildren - 1) / kMaxChildren);
+    const std::size_t groupCount = std::max<std::size_t>(2, parts);
+    for (std::size_t g = 0; g < groupCount; ++g) {
+        const std::size_t from = items.size() * g / groupCount,
+                          to = items.size() * (g + 1) / groupCount;
+        std::vector<std::uint32_t> group;
+        for (std::size_t i = from; i < to; ++i) group.push_back(items[i].second);
+        groups.push_back(group.size() == 1 ? group[0] : Constrain(std::move(group)));
+    }
+    return AddCluster(std::move(groups));
+}
+
+void Hierarchy::Finish(std::uint32_t index) {
+    // Iterative post-order: triangle ranges, areas and bounding spheres.
+    std::vector<std::pair<std::uint32_t, bool>> stack = {{index, false}};
+    while (!stack.empty()) {
+        auto [n, expanded] = stack.back();
+        stack.pop_back();
+        HrcNode& node = nodes_[n];
+        if (node.patch) {
+            node.first = static_cast<std::uint32_t>(triangleOrder_.size());
+            node.count = 1;
+            triangleOrder_.push_back(node.triangle);
+            node.areaM2 = flat_.triangles[node.triangle].areaM2;
+            cumulativeArea_.push_back(cumulativeArea_.back() + node.areaM2);
+            const glm::dvec3 lo = glm::min(node.a, glm::min(node.b, node.c));
+            const glm::dvec3 hi = glm::max(node.a, glm::max(node.b, node.c));
+            node.centre = 0.5 * (lo + hi);
+            node.radius = 0.5 * glm::length(hi - lo);
+            continue;
+        }
+        if (!expanded) {
+            node.first = static_cast<std::uint32_t>(triangleOrder_.size());
+            stack.push_back({n, true});
+            for (auto it = node.children.rbegin(); it != node.children.rend(); ++it)
+                stack.push_back({*it, false});
+            continue;
+        }
+        node.count = static_cast<std::uint32_t>(triangleOrder_.size()) - node.first;
+        glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+        node.areaM2 = 0.0;
+        for (std::uint32_t child : node.children) {
+            const HrcNode& c = nodes_[child];
+            node.areaM2 += c.areaM2;
+            lo = glm::min(lo, c.centre - glm::dvec3(c.radius));
+            hi = glm::max(hi, c.centre + glm::dvec3(c.radius));
+        }
+        node.centre = 0.5 * (lo + hi);
+        node.radius = 0.0;
+        for (std::uint32_t child : node.children) {
+            const HrcNode& c = nodes_[child];
+            node.radius = std::max(node.radius, glm::length(c.centre - node.centre) + c.radius);
+        }
+    }
+}
+
+bool Hierarchy::Subdivide(std::uint32_t index, double minAreaM2) {
+    HrcNode& node = nodes_[index];
+    LEAFLUX_CHECK(node.patch);
+    if (!node.children.empty() || node.areaM2 / 4.0 < minAreaM2) return false;
+    const glm::dvec3 a = node.a, b = node.b, c = node.c;
+    const glm::dvec3 ab = 0.5 * (a + b), bc = 0.5 * (b + c), ca = 0.5 * (c + a);
+    const glm::dvec3 corners[4][3] = {{a, ab, ca}, {ab, b, bc}, {ca, bc, c}, {ab, bc, ca}};
+    const HrcNode parent = node;  // nodes_ may move below
+    std::vector<std::uint32_t> children;
+    for (const auto& corner : corners) {
+        HrcNode child;
+        child.patch = true;
+        child.parent = index;
+        child.a = corner[0], child.b = corner[1], child.c = corner[2];
+        child.normal = parent.normal;
+        child.triangle = parent.triangle;
+        child.receiver = parent.receiver;
+        child.depth = parent.depth + 1;
+        child.areaM2 = parent.areaM2 / 4.0;
+        child.first = parent.first;
+        child.count = parent.count;
+        const glm::dvec3 lo = glm::min(child.a, glm::min(child.b, child.c));
+        const glm::dvec3 hi = glm::max(child.a, glm::max(child.b, child.c));
+        child.centre = 0.5 * (lo + hi);
+        child.radius = 0.5 * glm::length(hi - lo);
+        nodes_.push_back(child);
+        children.push_back(static_cast<std::uint32_t>(nodes_.size() - 1));
+    }
+    nodes_[index].children = std::move(children);
+    return true;
+}
+
+Hierarchy::Point Hierarchy::Sample(std::uint32_t index, double u, double v) const {
+    const HrcNode& node = nodes_[index];
+    glm::dvec3 a = node.a, b = node.b, c = node.c;
+    std::uint32_t triangle = node.triangle;
+    if (!node.patch) {
+        // An original triangle by area, then a point inside it.
+        const double lo = cumulativeArea_[node.first],
+                     hi = cumulativeArea_[node.first + node.count];
+        const double target = lo + u * (hi - lo);
+        auto it = std::upper_bound(cumulativeArea_.begin() + node.first + 1,
+                                   cumulativeArea_.begin() + node.first + node.count + 1, target);
+        if (it == cumulativeArea_.begin() + node.first + node.count + 1) --it;
+        const std::size_t k = static_cast<std::size_t>(it - cumulativeArea_.begin()) - 1;
+        u = std::clamp(
+            (target - cumulativeArea_[k]) / (cumulativeArea_[k + 1] - cumulativeArea_[k]), 0.0,
+            1.0);
+        triangle = triangleOrder_[k];
+        const Triangle& t = flat_.triangles[triangle];
+        a = t.a, b = t.b, c = t.c;
+    }
+    const glm::dvec3 w = UniformTriangle(u, v);
+    return {w.x * a + w.y * b + w.z * c, flat_.triangles[triangle].normal, triangle};
+}
+
+}  // namespace leaflux

@@ -1,0 +1,76 @@
+// The element and cluster hierarchy of hierarchical radiosity with clustering (Smits 1994,
+// Sillion 1995; Soler 2003 §3.1, §4.1).
+//
+// Leaves of the hierarchy are patches: triangles of the flat scene, subdivided into four
+// on demand. Clusters follow the botanical topology (plant → axis → … → organ), with
+// extra spatial levels inserted wherever a cluster would have more than kMaxChildren
+// children (a constrained clusterer, §4.1 last paragraph); environment surfaces and lamps
+// are grouped spatially. Invariant: a node's children partition its patches; `first` and
+// `count` index the node's original triangles in `triangleOrder`, contiguous.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <vector>
+
+#include "solver/geometry.h"
+#include "solver/sampling.h"
+
+namespace leaflux {
+
+inline constexpr int kMaxChildren = 8;
+inline constexpr std::uint32_t kNoNode = 0xFFFFFFFFu;
+
+struct HrcNode {
+    std::uint32_t parent = kNoNode;
+    std::vector<std::uint32_t> children;
+    bool patch = false;
+    // Patches: the triangle (FlatScene local frame), its flat triangle and receiver.
+    glm::dvec3 a{0.0}, b{0.0}, c{0.0}, normal{0.0};
+    std::uint32_t triangle = 0;
+    std::uint32_t receiver = 0;
+    int depth = 0;  // subdivision depth of a patch (0: a flat triangle)
+    // Every node: area (m²), bounding sphere, and its original triangles.
+    double areaM2 = 0.0;
+    glm::dvec3 centre{0.0};
+    double radius = 0.0;
+    std::uint32_t first = 0, count = 0;
+};
+
+class Hierarchy {
+  public:
+    explicit Hierarchy(const Scene& scene, const FlatScene& flat);
+
+    std::uint32_t Root() const { return root_; }
+    HrcNode& operator[](std::uint32_t i) { return nodes_[i]; }
+    const HrcNode& operator[](std::uint32_t i) const { return nodes_[i]; }
+    std::size_t Size() const { return nodes_.size(); }
+    const FlatScene& Flat() const { return flat_; }
+
+    // Splits a patch into four (midpoint subdivision); returns false when it is already
+    // split or its children would be smaller than minAreaM2.
+    bool Subdivide(std::uint32_t patch, double minAreaM2);
+
+    // A point on the node's surfaces, area-weighted, from two uniform numbers; with the
+    // flat triangle it lies on (for rays to leave it).
+    struct Point {
+        glm::dvec3 position, normal;
+        std::uint32_t triangle;
+    };
+    Point Sample(std::uint32_t node, double u, double v) const;
+
+  private:
+    std::uint32_t AddPatch(std::uint32_t triangle);
+    std::uint32_t AddCluster(std::vector<std::uint32_t> children);
+    // Groups children into at most kMaxChildren subtrees by median splits in space.
+    std::uint32_t Constrain(std::vector<std::uint32_t> children);
+    void Finish(std::uint32_t node);
+
+    const FlatScene& flat_;
+    std::vector<HrcNode> nodes_;
+    std::vector<std::uint32_t> triangleOrder_;  // flat triangles in hierarchy order
+    std::vector<double> cumulativeArea_;        // over triangleOrder_, starting at 0
+    std::uint32_t root_ = kNoNode;
+};
+
+}  // namespace leaflux

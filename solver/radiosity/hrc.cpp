@@ -1,0 +1,813 @@
+#include "solver/radiosity/hrc.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <unordered_map>
+
+#include "solver/check.h"
+#include "solver/directions.h"
+#include "solver/memory.h"
+#include "solver/radiosity/form_factor.h"
+#include "solver/radiosity/hierarchy.h"
+#include "solver/sampling.h"
+
+namespace leaflux {
+namespace {
+
+constexpr double kPi = glm::pi<double>();
+constexpr int kUpper = 0, kLower = 1;
+// Spheres closer than this many radii cannot exchange light as points.
+constexpr double kNearFieldRatio = 1.5;
+
+using Spectrum = std::array<double, kMaxBands>;
+using Sided = std::array<Spectrum, 2>;
+
+struct Interpolation {
+    std::array<int, 3> index{};
+    std::array<double, 3> weight{};
+};
+
+Interpolation Locate(const DirectionSet& set, const glm::dvec3& direction) {
+    const auto located = set.Locate(direction);
+    return {located.vertex, located.weight};
+}
+
+// Light from a node S to a node R.
+struct NodeLink {
+    std::uint32_t sender;
+    bool exact;  // patch ← patch by the analytic form factor
+    double formUpper = 0.0, formLower = 0.0, solidAngleSr = 0.0;
+    int senderSide = kUpper;  // a patch sender: its side facing R
+    // Cluster sender: v / d², times its intensity. Patch sender: v Ω / π, times its
+    // radiosity (Ω the solid angle it subtends at R's centre: bounded however near).
+    double geometric = 0.0;
+    glm::dvec3 toSender{0.0};  // unit, from R's centre
+    Interpolation receiverBins, senderBins;
+};
+
+struct SourceLink {
+    std::uint32_t source;
+    double visibility;
+};
+
+struct DirectionalSource {
+    glm::dvec3 toward;
+    Spectrum normalIrradiance{};
+};
+
+struct SideOptics {
+    Spectrum rho[2]{}, tau[2]{};  // tau[s]: arriving on side s, leaving the other side
+};
+
+// How uncertain a visibility estimated from n rays is, as 2√(v(1−v)) with v taken by
+// Laplace's rule, (visible + 1) / (n + 2): never zero, since eight rays that all pass do
+// not prove that nothing is in the way.
+double VisibilitySpread(double visible, int rays) {
+    const double v = (visible * rays + 1.0) / (rays + 2.0);
+    return 2.0 * std::sqrt(v * (1.0 - v));
+}
+
+class HrcSolver {
+  public:
+    HrcSolver(const Scene& scene, const FlatScene& flat, const RayScene& rays,
+              const HrcOptions& options)
+        : scene_(scene),
+          flat_(flat),
+          rays_(rays),
+          options_(options),
+          hierarchy_(scene, flat),
+          directions_(DirectionSet::OfLevel(options.directionLevel)),
+          bands_(static_cast<int>(scene.bands.size())),
+          bins_(directions_.Size()) {
+        std::unordered_map<NodeId, NodeType> types;
+        for (const Node& node : scene.nodes) types[node.id] = node.type;
+        for (const Receiver& receiver : flat.receivers) {
+            optics_.push_back(OpticsOf(receiver));
+            // Internodes and fruits are solids: light reaches their outer (upper) side only.
+            const bool organ = receiver.kind == ReceiverKind::kOrgan;
+            const NodeType type = organ ? types.at(receiver.node) : NodeType::kOther;
+            solid_.push_back(type == NodeType::kInternode || type == NodeType::kFruit);
+        }
+        for (const Sun& sun : scene.sources.suns) AddSource(sun.towardSun, sun.normalIrradianceWm2);
+        for (const Sky& sky : scene.sources.skies) {
+            Sky discrete = sky;
+            if (discrete.discretization == SkyDiscretization::kContinuous)
+                discrete.discretization = options.skyCones;
+            for (const SkyCone& cone : discrete.Cones()) {
+                std::vector<double> irradiance;
+                for (double radiance : cone.radianceWm2Sr)
+                    irradiance.push_back(radiance * cone.solidAngleSr);
+                AddSource(cone.direction, irradiance);
+            }
+        }
+    }
+
+    Solution Run() {
+        const auto start = std::chrono::steady_clock::now();
+        const double cpuStart = CpuSeconds();
+        Solution solution;
+        solution.light.assign(flat_.receivers.size(), std::vector<BandLight>(bands_));
+        solution.balance.assign(bands_, EnergyBalance{});
+        const int threads =
+            options_.threads > 0 ? options_.threads : tbb::info::default_concurrency();
+        tbb::task_arena arena(threads);
+        if (hierarchy_.Root() != kNoNode) {
+            arena.execute([&] { Solve(solution); });
+        }
+        solution.stats.wallSeconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        solution.stats.cpuSeconds = CpuSeconds() - cpuStart;
+        solution.stats.peakRssBytes = PeakRssBytes();
+        solution.stats.threads = threads;
+        solution.stats.rays = rayCount_;
+        return solution;
+    }
+
+  private:
+    SideOptics OpticsOf(const Receiver& receiver) const {
+        SideOptics o;
+        if (receiver.optics < 0) return o;
+        const auto& bands = scene_.optics[receiver.optics].bands;
+        for (int b = 0; b < bands_; ++b) {
+            o.rho[kUpper][b] = bands[b].rhoUpper;
+            o.rho[kLower][b] = bands[b].rhoLower;
+            o.tau[kUpper][b] = bands[b].tauUpperToLower;
+            o.tau[kLower][b] = bands[b].tauLowerToUpper;
+        }
+        return o;
+    }
+
+    void AddSource(const glm::dvec3& toward, const std::vector<double>& irradiance) {
+        DirectionalSource source{toward, {}};
+        double total = 0.0;
+        for (int b = 0; b < bands_; ++b) total += source.normalIrradiance[b] = irradiance[b];
+        if (total > 0.0) sources_.push_back(source);
+    }
+
+    // ---- Geometry of nodes -------------------------------------------------------------
+
+    // Σ A |n · ω| of the node's patches (both sides together).
+    double ProjectedArea(std::uint32_t n, const glm::dvec3& omega) const {
+        const HrcNode& node = hierarchy_[n];
+        if (node.patch) return node.areaM2 * std::abs(glm::dot(node.normal, omega));
+        const Interpolation w = Locate(directions_, omega);
+        double area = 0.0;
+        for (int k = 0; k < 3; ++k) area += w.weight[k] * projected_[slot_[n] * bins_ + w.index[k]];
+        return area;
+    }
+
+    // Radiant intensity (W/sr) of band b leaving node n towards ω.
+    double Intensity(std::uint32_t n, const glm::dvec3& omega, int b) const {
+        const HrcNode& node = hierarchy_[n];
+        if (node.patch) {
+            const double cosine = glm::dot(node.normal, omega);
+            return node.areaM2 * std::abs(cosine) *
+                   radiosity_[n][cosine > 0.0 ? kUpper : kLower][b] / kPi;
+        }
+        const Interpolation w = Locate(directions_, omega);
+        double value = 0.0;
+        for (int k = 0; k < 3; ++k)
+            value += w.weight[k] * intensity_[(slot_[n] * bins_ + w.index[k]) * bands_ + b];
+        return value;
+    }
+
+    double Power(std::uint32_t n, const glm::dvec3& omega) const {
+        double total = 0.0;
+        for (int b = 0; b < bands_; ++b) total += Intensity(n, omega, b);
+        return total;
+    }
+
+    // How much a receiving point of normal n on a triangle takes of light from ω: |n · ω|,
+    // but nothing on the inner side of a solid.
+    double ReceivingWeight(std::uint32_t triangle, const glm::dvec3& n,
+                           const glm::dvec3& omega) const {
+        const double cosine = glm::dot(n, omega);
+        if (cosine < 0.0 && solid_[flat_.triangles[triangle].receiver]) return 0.0;
+        return std::abs(cosine);
+    }
+
+    // The unoccluded fraction of the light from s that r's points take, from stratified
+    // rays between points of r and s, weighted as push-down hands the light to patches.
+    double Visibility(std::uint32_t r, std::uint32_t s) {
+        Random random(StreamSeed(0x5EED, r, s));
+        const int count = options_.visibilityRays;
+        double visible = 0.0, total = 0.0;
+        for (int i = 0; i < count; ++i) {
+            const Hierarchy::Point p =
+                hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
+            const Hierarchy::Point q = hierarchy_.Sample(s, random.Uniform(), random.Uniform());
+            const glm::dvec3 d = q.position - p.position;
+            const double distance = glm::length(d);
+            if (distance <= 0.0) continue;
+            const double weight = ReceivingWeight(p.triangle, p.normal, d / distance);
+            if (weight <= 0.0) continue;
+            ++rayCount_;
+            total += weight;
+            if (!rays_.Occluded({p.position, p.triangle}, d / distance, distance * (1.0 - 1e-4)))
+                visible += weight;
+        }
+        return total > 0.0 ? visible / total : 0.0;
+    }
+
+    // The lit fraction of the node's area as seen from the source: sample points weighted
+    // by |n · ω|, the weight with which push-down hands the source's light to each patch.
+    double SourceVisibility(std::uint32_t r, std::uint32_t source) {
+        const glm::dvec3& toward = sources_[source].toward;
+        Random random(StreamSeed(0x50C, r, source));
+        const int count = options_.visibilityRays;
+        double visible = 0.0, total = 0.0;
+        for (int i = 0; i < count; ++i) {
+            const Hierarchy::Point p =
+                hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
+            const double weight = ReceivingWeight(p.triangle, p.normal, toward);
+            if (weight <= 0.0) continue;
+            ++rayCount_;
+            total += weight;
+            if (!rays_.Occluded({p.position, p.triangle}, toward)) visible += weight;
+        }
+        return total > 0.0 ? visible / total : 0.0;
+    }
+
+    // Whether node n can be split, subdividing a patch if it must.
+    bool Splittable(std::uint32_t n) {
+        HrcNode& node = hierarchy_[n];
+        if (!node.patch) return true;
+        if (!node.children.empty()) return true;
+        if (node.depth >= options_.maxSubdivision) return false;
+        const double minArea =
+            flat_.triangles[node.triangle].areaM2 / std::pow(4.0, options_.maxSubdivision) * 0.999;
+        if (!hierarchy_.Subdivide(n, minArea)) return false;
+        Grow();
+        for (std::uint32_t child : hierarchy_[n].children) {
+            radiosity_[child] = radiosity_[n];
+            emitted_[child] = 0.25 * emitted_[n];
+        }
+        return true;
+    }
+
+    void Grow() {
+        radiosity_.resize(hierarchy_.Size(), Sided{});
+        emitted_.resize(hierarchy_.Size(), 0.0);
+        links_.resize(hierarchy_.Size());
+        sourceLinks_.resize(hierarchy_.Size());
+    }
+
+    // ---- Refinement ---------------------------------------------------------------------
+
+    void RefineSource(std::uint32_t r, std::uint32_t s) {
+        const DirectionalSource& source = sources_[s];
+        double power = 0.0;
+        for (int b = 0; b < bands_; ++b) power += source.normalIrradiance[b];
+        const double unoccluded = power * ProjectedArea(r, source.toward);
+        if (unoccluded <= 0.0) return;
+        const double v = SourceVisibility(r, s);
+        const double error = unoccluded * VisibilitySpread(v, options_.visibilityRays);
+        if (error > options_.epsilon * totalPower_ && Splittable(r)) {
+            const std::vector<std::uint32_t> children = hierarchy_[r].children;
+            for (std::uint32_t child : children) RefineSource(child, s);
+            return;
+        }
+        if (v > 0.0) sourceLinks_[r].push_back({s, v});
+    }
+
+    void RefineSelf(std::uint32_t c) {
+        if (hierarchy_[c].patch) return;  // flat: a patch does not see itself
+        const std::vector<std::uint32_t> children = hierarchy_[c].children;
+        for (std::uint32_t i : children) {
+            for (std::uint32_t j : children) {
+                if (i != j) RefinePair(i, j);
+            }
+            RefineSelf(i);
+        }
+    }
+
+    void SplitAndRefine(std::uint32_t r, std::uint32_t s, bool splitReceiver) {
+        const std::vector<std::uint32_t> children = hierarchy_[splitReceiver ? r : s].children;
+        for (std::uint32_t child : children) {
+            if (splitReceiver) {
+                RefinePair(child, s);
+            } else {
+                RefinePair(r, child);
+            }
+        }
+    }
+
+    void RefinePair(std::uint32_t r, std::uint32_t s) {
+        const HrcNode& R = hierarchy_[r];
+        const HrcNode& S = hierarchy_[s];
+        if (R.patch && S.patch) return RefineExact(r, s);
+        const glm::dvec3 between = S.centre - R.centre;
+        const double d = glm::length(between);
+        const glm::dvec3 toSender = d > 0.0 ? between / d : glm::dvec3(0, 0, 1);
+        // A patch sends B/π over the solid angle it subtends; a cluster sends its intensity
+        // over d², which is bounded for overlapping clusters by the size of their union.
+        double geometric = 0.0, sender = 0.0, geometricError = 0.0;
+        int senderSide = kUpper;
+        if (S.patch) {
+            const glm::dvec3 centre = (S.a + S.b + S.c) / 3.0;
+            senderSide = glm::dot(S.normal, R.centre - centre) >= 0.0 ? kUpper : kLower;
+            const glm::dvec3 ra = glm::normalize(S.a - R.centre),
+                             rb = glm::normalize(S.b - R.centre),
+                             rc = glm::normalize(S.c - R.centre);
+            geometric = SphericalTriangleSolidAngle(ra, rb, rc) / kPi;
+            double radiosity = 0.0;
+            for (int b = 0; b < bands_; ++b) radiosity += radiosity_[s][senderSide][b];
+            sender = radiosity * geometric * ProjectedArea(r, toSender);
+            // One direction stands for the whole patch and R for all its points.
+            geometricError =
+                std::min(1.0, std::pow((R.radius + S.radius) / std::max(d, 1e-300), 2.0));
+        } else {
+            const double square = std::max(d * d, 0.25 * std::pow(R.radius + S.radius, 2.0));
+            geometric = 1.0 / square;
+            // The error bound does not trust the bounded transfer of overlapping clusters:
+            // there, all the sender's power may land on the receiver.
+            sender = Power(s, -toSender) * ProjectedArea(r, toSender) / std::max(d * d, 1e-300);
+            geometricError =
+                std::min(1.0, std::pow(R.radius + S.radius, 2.0) / std::max(d * d, 1e-300));
+        }
+        sender = std::min(sender, emitted_[s]);
+        // A sender still dark after the direct light is linked where it stands: it may
+        // light up as light bounces, and dropping it would lose that light.
+        const double v = Visibility(r, s);
+        const double error =
+            sender * (geometricError + VisibilitySpread(v, options_.visibilityRays));
+        if (error > options_.epsilon * totalPower_) {
+            const bool receiverLarger = R.radius >= S.radius;
+            if (receiverLarger ? Splittable(r) : Splittable(s))
+                return SplitAndRefine(r, s, receiverLarger);
+            if (receiverLarger ? Splittable(s) : Splittable(r))
+                return SplitAndRefine(r, s, !receiverLarger);
+        }
+        if (v <= 0.0) return;
+        NodeLink link{s, false};
+        link.geometric = v * geometric;
+        link.senderSide = senderSide;
+        link.toSender = toSender;
+        link.receiverBins = Locate(directions_, toSender);
+        link.senderBins = Locate(directions_, -toSender);
+        links_[r].push_back(link);
+    }
+
+    // Patch ← patch: Lambert's formula at the receiver's centre, per side.
+    void RefineExact(std::uint32_t r, std::uint32_t s) {
+        const HrcNode& R = hierarchy_[r];
+        const HrcNode& S = hierarchy_[s];
+        const glm::dvec3 x = (R.a + R.b + R.c) / 3.0;
+        const SidedFormFactor f = PointToTriangle(x, R.normal, S.a, S.b, S.c);
+        if (f.upper + f.lower <= 0.0) return;
+        const int senderSide =
+            glm::dot(S.normal, x - (S.a + S.b + S.c) / 3.0) >= 0.0 ? kUpper : kLower;
+        double radiosity = 0.0;
+        for (int b = 0; b < bands_; ++b) radiosity += radiosity_[s][senderSide][b];
+        const double unoccluded = radiosity * (f.upper + f.lower) * R.areaM2;
+        const double v = Visibility(r, s);
+        const double d = std::max(glm::length(S.centre - R.centre), 1e-300);
+        const double error = unoccluded * (std::pow(R.radius / d, 2.0) +
+                                           VisibilitySpread(v, options_.visibilityRays));
+        if (error > options_.epsilon * totalPower_) {
+            const bool receiverLarger = R.radius >= S.radius;
+            if (receiverLarger ? Splittable(r) : Splittable(s))
+                return SplitAndRefine(r, s, receiverLarger);
+            if (receiverLarger ? Splittable(s) : Splittable(r))
+                return SplitAndRefine(r, s, !receiverLarger);
+        }
+        if (v <= 0.0) return;
+        NodeLink link{s, true};
+        link.formUpper = f.upper * v;
+        link.formLower = f.lower * v;
+        link.solidAngleSr = f.solidAngleSr * v;
+        link.senderSide = senderSide;
+        link.toSender = glm::normalize((S.a + S.b + S.c) / 3.0 - x);
+        links_[r].push_back(link);
+    }
+
+    // ---- Solution -----------------------------------------------------------------------
+
+    void Solve(Solution& solution);
+    void Index();
+    void PullUp();
+    void Gather();
+    void PushDown(bool sourcesOnly);
+    double UpdateRadiosity();
+    void Outputs(Solution& solution);
+
+    const Scene& scene_;
+    const FlatScene& flat_;
+    const RayScene& rays_;
+    const HrcOptions& options_;
+    Hierarchy hierarchy_;
+    const DirectionSet& directions_;
+    const int bands_;
+    const int bins_;
+    std::vector<SideOptics> optics_;
+    std::vector<bool> solid_;  // by receiver
+    std::vector<DirectionalSource> sources_;
+    double totalPower_ = 0.0;
+    std::int64_t rayCount_ = 0;
+
+    std::vector<std::vector<NodeLink>> links_;  // by receiver node
+    std::vector<std::vector<SourceLink>> sourceLinks_;
+    std::vector<Sided> radiosity_;            // patches
+    std::vector<std::uint32_t> slot_;         // clusters: index into the bin arrays
+    std::vector<double> projected_;           // [slot][bin]
+    std::vector<double> emitted_;             // per node: W leaving, all bands
+    std::vector<double> intensity_;           // [slot][bin][band], W/sr
+    std::vector<double> gatheredBins_;        // [slot][bin][band], W/m² normal
+    std::vector<Sided> gatheredSides_;        // patches: W/m² per side
+    std::vector<Spectrum> gatheredIntegral_;  // patches: ∫ L dω
+    std::vector<std::array<glm::dvec3, kMaxBands>> gatheredMoment_;
+    std::vector<std::uint32_t> preOrder_;   // parents before children
+    std::vector<std::uint32_t> receivers_;  // nodes with links
+    // Leaf patches: the light of the last push.
+    std::vector<Sided> irradiance_, direct_;
+    std::vector<Spectrum> integral_;
+    std::vector<std::array<glm::dvec3, kMaxBands>> moment_;
+    std::vector<Spectrum> emission_;  // exitance of emitter patches
+};
+
+void HrcSolver::Index() {
+    preOrder_.clear();
+    std::vector<std::uint32_t> stack = {hierarchy_.Root()};
+    while (!stack.empty()) {
+        const std::uint32_t n = stack.back();
+        stack.pop_back();
+        preOrder_.push_back(n);
+        const auto& children = hierarchy_[n].children;
+        for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);
+    }
+    Grow();
+    if (slot_.empty()) {
+        // Clusters never change after construction: their slots and projected areas once.
+        slot_.assign(hierarchy_.Size(), kNoNode);
+        std::uint32_t slots = 0;
+        for (std::uint32_t n : preOrder_) {
+            if (!hierarchy_[n].patch) slot_[n] = slots++;
+        }
+        projected_.assign(static_cast<std::size_t>(slots) * bins_, 0.0);
+        intensity_.assign(static_cast<std::size_t>(slots) * bins_ * bands_, 0.0);
+        gatheredBins_.assign(intensity_.size(), 0.0);
+        for (auto it = preOrder_.rbegin(); it != preOrder_.rend(); ++it) {
+            const HrcNode& node = hierarchy_[*it];
+            if (node.patch) continue;
+            for (std::uint32_t child : node.children) {
+                for (int d = 0; d < bins_; ++d) {
+                    projected_[slot_[*it] * bins_ + d] +=
+                        ProjectedArea(child, directions_.Direction(d));
+                }
+            }
+        }
+    }
+    slot_.resize(hierarchy_.Size(), kNoNode);
+    const std::size_t size = hierarchy_.Size();
+    gatheredSides_.assign(size, Sided{});
+    gatheredIntegral_.assign(size, Spectrum{});
+    gatheredMoment_.assign(size, {});
+    irradiance_.resize(size, Sided{});
+    direct_.resize(size, Sided{});
+    integral_.resize(size, Spectrum{});
+    moment_.resize(size, {});
+    emission_.assign(size, Spectrum{});
+    for (std::uint32_t n = 0; n < size; ++n) {
+        const HrcNode& node = hierarchy_[n];
+        if (!node.patch) continue;
+        const Receiver& receiver = flat_.receivers[node.receiver];
+        if (receiver.kind != ReceiverKind::kEmitter) continue;
+        const auto& exitance = scene_.sources.emitters[receiver.emitter].exitanceWm2;
+        for (int b = 0; b < bands_; ++b) emission_[n][b] = exitance[b];
+    }
+    receivers_.clear();
+    for (std::uint32_t n = 0; n < size; ++n) {
+        if (!links_[n].empty()) receivers_.push_back(n);
+    }
+}
+
+void HrcSolver::PullUp() {
+    emitted_.assign(hierarchy_.Size(), 0.0);
+    for (auto it = preOrder_.rbegin(); it != preOrder_.rend(); ++it) {
+        const std::uint32_t n = *it;
+        const HrcNode& node = hierarchy_[n];
+        if (node.patch && node.children.empty()) {
+            for (int b = 0; b < bands_; ++b)
+                emitted_[n] += node.areaM2 * (radiosity_[n][kUpper][b] + radiosity_[n][kLower][b]);
+        }
+        if (node.parent != kNoNode) emitted_[node.parent] += emitted_[n];
+        if (node.patch) {
+            if (node.children.empty()) continue;
+            Sided mean{};  // a split patch radiates the mean of its four parts
+            for (std::uint32_t child : node.children) {
+                for (int s : {kUpper, kLower}) {
+                    for (int b = 0; b < bands_; ++b) mean[s][b] += 0.25 * radiosity_[child][s][b];
+                }
+            }
+            radiosity_[n] = mean;
+            continue;
+        }
+        double* out = &intensity_[static_cast<std::size_t>(slot_[n]) * bins_ * bands_];
+        std::fill(out, out + bins_ * bands_, 0.0);
+        for (std::uint32_t child : node.children) {
+            const HrcNode& c = hierarchy_[child];
+            if (!c.patch) {
+                const double* in =
+                    &intensity_[static_cast<std::size_t>(slot_[child]) * bins_ * bands_];
+                for (int i = 0; i < bins_ * bands_; ++i) out[i] += in[i];
+                continue;
+            }
+            for (int d = 0; d < bins_; ++d) {
+                const double cosine = glm::dot(c.normal, directions_.Direction(d));
+                const int side = cosine > 0.0 ? kUpper : kLower;
+                const double scale = c.areaM2 * std::abs(cosine) / kPi;
+                for (int b = 0; b < bands_; ++b)
+                    out[d * bands_ + b] += scale * radiosity_[child][side][b];
+            }
+        }
+    }
+}
+
+void HrcSolver::Gather() {
+    tbb::parallel_for(std::size_t{0}, receivers_.size(), [&](std::size_t i) {
+        const std::uint32_t r = receivers_[i];
+        const HrcNode& R = hierarchy_[r];
+        Sided& sides = gatheredSides_[r];
+        Spectrum& integral = gatheredIntegral_[r];
+        auto& moment = gatheredMoment_[r];
+        sides = Sided{};
+        integral = Spectrum{};
+        moment = {};
+        double* bins =
+            R.patch ? nullptr : &gatheredBins_[static_cast<std::size_t>(slot_[r]) * bins_ * bands_];
+        if (bins) std::fill(bins, bins + bins_ * bands_, 0.0);
+        for (const NodeLink& link : links_[r]) {
+            if (link.exact) {
+                const Spectrum& b = radiosity_[link.sender][link.senderSide];
+                for (int k = 0; k < bands_; ++k) {
+                    sides[kUpper][k] += link.formUpper * b[k];
+                    sides[kLower][k] += link.formLower * b[k];
+                    const double radiance = b[k] / kPi * link.solidAngleSr;
+                    integral[k] += radiance;
+                    moment[k] += radiance * link.toSender;
+                }
+                continue;
+            }
+            const HrcNode& S = hierarchy_[link.sender];
+            for (int k = 0; k < bands_; ++k) {
+                double sent = 0.0;  // radiosity of a patch, intensity of a cluster
+                if (S.patch) {
+                    sent = radiosity_[link.sender][link.senderSide][k];
+                } else {
+                    const double* in =
+                        &intensity_[static_cast<std::size_t>(slot_[link.sender]) * bins_ * bands_];
+                    for (int j = 0; j < 3; ++j)
+                        sent +=
+                            link.senderBins.weight[j] * in[link.senderBins.index[j] * bands_ + k];
+                }
+                const double normal = sent * link.geometric;  // W/m² facing the sender
+                if (R.patch) {
+                    const double cosine = glm::dot(R.normal, link.toSender);
+                    sides[cosine > 0.0 ? kUpper : kLower][k] += normal * std::abs(cosine);
+                    integral[k] += normal;
+                    moment[k] += normal * link.toSender;
+                } else {
+                    for (int j = 0; j < 3; ++j)
+                        bins[link.receiverBins.index[j] * bands_ + k] +=
+                            link.receiverBins.weight[j] * normal;
+                }
+            }
+        }
+    });
+}
+
+void HrcSolver::PushDown(bool sourcesOnly) {
+    // Depth-first with one accumulator per depth: what every ancestor gathered.
+    struct Level {
+        std::vector<double> bins;     // [bin][band]
+        std::vector<double> sources;  // visibility-weighted, per source
+        Sided sides{};
+        Spectrum integral{};
+        std::array<glm::dvec3, kMaxBands> moment{};
+    };
+    std::vector<Level> levels;
+    std::vector<std::pair<std::uint32_t, int>> stack = {{hierarchy_.Root(), 0}};
+    while (!stack.empty()) {
+        const auto [n, depth] = stack.back();
+        stack.pop_back();
+        if (static_cast<int>(levels.size()) <= depth) {
+            levels.push_back({std::vector<double>(bins_ * bands_, 0.0),
+                              std::vector<double>(sources_.size(), 0.0)});
+        }
+        Level& level = levels[depth];
+        if (depth == 0) {
+            std::fill(level.bins.begin(), level.bins.end(), 0.0);
+            std::fill(level.sources.begin(), level.sources.end(), 0.0);
+            level.sides = Sided{};
+            level.integral = Spectrum{};
+            level.moment = {};
+        } else {
+            const Level& parent = levels[depth - 1];
+            level.bins = parent.bins;
+            level.sources = parent.sources;
+            level.sides = parent.sides;
+            level.integral = parent.integral;
+            level.moment = parent.moment;
+        }
+        const HrcNode& node = hierarchy_[n];
+        for (const SourceLink& link : sourceLinks_[n])
+            level.sources[link.source] += link.visibility;
+        if (!sourcesOnly) {
+            if (node.patch) {
+                for (int k = 0; k < bands_; ++k) {
+                    level.sides[kUpper][k] += gatheredSides_[n][kUpper][k];
+                    level.sides[kLower][k] += gatheredSides_[n][kLower][k];
+                    level.integral[k] += gatheredIntegral_[n][k];
+                    level.moment[k] += gatheredMoment_[n][k];
+                }
+            } else {
+                const double* in =
+                    &gatheredBins_[static_cast<std::size_t>(slot_[n]) * bins_ * bands_];
+                for (int i = 0; i < bins_ * bands_; ++i) level.bins[i] += in[i];
+            }
+        }
+        if (!node.patch || !node.children.empty()) {
+            for (std::uint32_t child : node.children) stack.push_back({child, depth + 1});
+            continue;
+        }
+        // A leaf patch: everything arriving, per side.
+        Sided e = level.sides;
+        Spectrum integral = level.integral;
+        auto moment = level.moment;
+        const bool solid = solid_[node.receiver];
+        for (int d = 0; d < bins_; ++d) {
+            const glm::dvec3& omega = directions_.Direction(d);
+            const double cosine = glm::dot(node.normal, omega);
+            if (solid && cosine < 0.0) continue;
+            for (int k = 0; k < bands_; ++k) {
+                const double normal = level.bins[d * bands_ + k];
+                e[cosine > 0.0 ? kUpper : kLower][k] += normal * std::abs(cosine);
+                integral[k] += normal;
+                moment[k] += normal * omega;
+            }
+        }
+        for (std::size_t s = 0; s < sources_.size(); ++s) {
+            if (level.sources[s] <= 0.0) continue;
+            const double cosine = glm::dot(node.normal, sources_[s].toward);
+            if (solid && cosine < 0.0) continue;
+            for (int k = 0; k < bands_; ++k) {
+                const double normal = sources_[s].normalIrradiance[k] * level.sources[s];
+                e[cosine > 0.0 ? kUpper : kLower][k] += normal * std::abs(cosine);
+                integral[k] += normal;
+                moment[k] += normal * sources_[s].toward;
+            }
+        }
+        irradiance_[n] = e;
+        integral_[n] = integral;
+        moment_[n] = moment;
+    }
+}
+
+double HrcSolver::UpdateRadiosity() {
+    double change = 0.0, largest = 0.0;
+    for (std::uint32_t n : preOrder_) {
+        const HrcNode& node = hierarchy_[n];
+        if (!node.patch || !node.children.empty()) continue;
+        const SideOptics& o = optics_[node.receiver];
+        const Sided& e = irradiance_[n];
+        for (int k = 0; k < bands_; ++k) {
+            const double upper =
+                emission_[n][k] + o.rho[kUpper][k] * e[kUpper][k] + o.tau[kLower][k] * e[kLower][k];
+            const double lower = o.rho[kLower][k] * e[kLower][k] + o.tau[kUpper][k] * e[kUpper][k];
+            change = std::max({change, std::abs(upper - radiosity_[n][kUpper][k]),
+                               std::abs(lower - radiosity_[n][kLower][k])});
+            largest = std::max({largest, upper, lower});
+            radiosity_[n][kUpper][k] = upper;
+            radiosity_[n][kLower][k] = lower;
+        }
+    }
+    return largest > 0.0 ? change / largest : 0.0;
+}
+
+void HrcSolver::Solve(Solution& solution) {
+    Grow();
+    Index();
+    for (std::uint32_t n : preOrder_) radiosity_[n][kUpper] = emission_[n];
+    // The power the sources bring in, unoccluded: the scale of every link's error.
+    for (const DirectionalSource& source : sources_) {
+        double power = 0.0;
+        for (int b = 0; b < bands_; ++b) power += source.normalIrradiance[b];
+        totalPower_ += power * ProjectedArea(hierarchy_.Root(), source.toward);
+    }
+    for (std::uint32_t n : preOrder_) {
+        for (int b = 0; b < bands_; ++b) totalPower_ += emission_[n][b] * hierarchy_[n].areaM2;
+    }
+    if (totalPower_ <= 0.0) return Outputs(solution);
+
+    for (std::uint32_t s = 0; s < sources_.size(); ++s) RefineSource(hierarchy_.Root(), s);
+    // Direct light first, so that links are refined on what senders will send.
+    Index();
+    PushDown(true);
+    UpdateRadiosity();
+    PullUp();
+    RefineSelf(hierarchy_.Root());
+    Index();
+
+    // Jacobi from the emission: the first sweep's light is the direct light.
+    for (std::uint32_t n : preOrder_) radiosity_[n] = Sided{}, radiosity_[n][kUpper] = emission_[n];
+    PullUp();
+    double residual = 0.0;
+    int iteration = 0;
+    for (; iteration < options_.maxIterations; ++iteration) {
+        Gather();
+        PushDown(false);
+        if (iteration == 0) direct_ = irradiance_;
+        residual = UpdateRadiosity();
+        PullUp();
+        if (residual <= options_.tolerance) break;
+    }
+    solution.stats.iterations = iteration + 1;
+    solution.stats.residual = residual;
+    Outputs(solution);
+}
+
+void HrcSolver::Outputs(Solution& solution) {
+    std::size_t links = 0;
+    for (const auto& l : links_) links += l.size();
+    for (const auto& l : sourceLinks_) links += l.size();
+    solution.stats.links = static_cast<std::int64_t>(links);
+    solution.stats.elements = static_cast<std::int64_t>(hierarchy_.Size());
+    if (hierarchy_.Root() == kNoNode) return;
+    // Escape: the cosine-weighted fraction of each leaf patch's sides that sees out.
+    std::vector<std::uint32_t> leaves;
+    for (std::uint32_t n : preOrder_) {
+        if (hierarchy_[n].patch && hierarchy_[n].children.empty()) leaves.push_back(n);
+    }
+    std::vector<std::array<double, 2>> escape(leaves.size());
+    std::vector<std::int64_t> rays(leaves.size(), 0);
+    tbb::parallel_for(std::size_t{0}, leaves.size(), [&](std::size_t i) {
+        SetFlushToZero();
+        const HrcNode& node = hierarchy_[leaves[i]];
+        Random random(StreamSeed(0xE5C, leaves[i]));
+        const int count = 2 * options_.visibilityRays;
+        for (int s : {kUpper, kLower}) {
+            int out = 0;
+            for (int k = 0; k < count; ++k) {
+                const Hierarchy::Point p =
+                    hierarchy_.Sample(leaves[i], random.Uniform(), random.Uniform());
+                const glm::dvec3 n = s == kUpper ? node.normal : -node.normal;
+                const glm::dvec3 omega =
+                    CosineHemisphere(n, (k + random.Uniform()) / count, random.Uniform());
+                out += rays_.Trace({p.position, p.triangle}, omega).fate != RayFate::kHit;
+            }
+            escape[i][s] = static_cast<double>(out) / count;
+            rays[i] += count;
+        }
+    });
+    for (std::int64_t r : rays) rayCount_ += r;
+    std::vector<double> area(flat_.receivers.size(), 0.0);
+    for (std::size_t i = 0; i < leaves.size(); ++i) {
+        const std::uint32_t n = leaves[i];
+        const HrcNode& node = hierarchy_[n];
+        const SideOptics& o = optics_[node.receiver];
+        const double a = node.areaM2;
+        area[node.receiver] += a;
+        for (int k = 0; k < bands_; ++k) {
+            BandLight& light = solution.light[node.receiver][k];
+            const Sided& e = irradiance_[n];
+            light.irradianceUpperWm2 += a * e[kUpper][k];
+            light.irradianceLowerWm2 += a * e[kLower][k];
+            const double absorbed =
+                a * ((1.0 - o.rho[kUpper][k] - o.tau[kUpper][k]) * e[kUpper][k] +
+                     (1.0 - o.rho[kLower][k] - o.tau[kLower][k]) * e[kLower][k]);
+            light.absorbedW += absorbed;
+            light.radianceIntegral += a * integral_[n][k];
+            light.radianceMoment += a * moment_[n][k];
+            EnergyBalance& balance = solution.balance[k];
+            balance.incidentW += a * (direct_[n][kUpper][k] + direct_[n][kLower][k]);
+            balance.absorbedW += absorbed;
+            balance.escapedW +=
+                a * ((radiosity_[n][kUpper][k] - emission_[n][k]) * escape[i][kUpper] +
+                     radiosity_[n][kLower][k] * escape[i][kLower]);
+        }
+    }
+    for (std::size_t r = 0; r < flat_.receivers.size(); ++r) {
+        for (BandLight& light : solution.light[r]) {
+            if (area[r] <= 0.0) continue;
+            light.irradianceUpperWm2 /= area[r];
+            light.irradianceLowerWm2 /= area[r];
+            light.radianceIntegral /= area[r];
+            light.radianceMoment /= area[r];
+        }
+    }
+}
+
+}  // namespace
+
+Solution SolveHrc(const Scene& scene, const FlatScene& flat, const RayScene& rays,
+                  const HrcOptions& options) {
+    LEAFLUX_CHECK(options.directionLevel >= 0 && options.directionLevel <= 4);
+    return HrcSolver(scene, flat, rays, options).Run();
+}
+
+}  // namespace leaflux

@@ -1,0 +1,43 @@
+// Hierarchical radiosity with clustering (`hrc`), the paper's baseline (Soler 2003 §3.1,
+// after Smits 1994 and Sillion 1995), with two-sided leaves (§4.3).
+//
+// Links join the nodes of a Hierarchy (clusters and patches) and the directional sources
+// (suns, sky cones) to nodes. A link between clusters carries light as a point transfer
+// I_S(ω) · v / d², the sender's intensity sampled on a tetrahedral direction set
+// (DirectionSet, §4.2.2) and the receiver's incoming light kept per direction, so that
+// clusters emit and receive as volumes with no assumption of flatness. A link between
+// two patches uses the analytic point-to-polygon form factor, bounded in the near field.
+// Visibility is the unoccluded fraction of deterministic stratified rays through Embree.
+//
+// Refinement: a link is split (the larger node, or a patch subdivided into four) while its
+// estimated error — the power it carries times its geometric error ((r_R + r_S)/d)² plus
+// its visibility spread 2√(v(1−v)) — exceeds ε times the power the sources bring into the
+// scene. Solution: Jacobi gathering with push/pull (B₁ = ρ₁I₁ + τ₂→₁I₂, B₂ = ρ₂I₂ + τ₁→₂I₁;
+// what is pulled up is the intensity of both sides), iterated to a residual tolerance.
+#pragma once
+
+#include <cstdint>
+
+#include "solver/light.h"
+#include "solver/raytrace.h"
+
+namespace leaflux {
+
+struct HrcOptions {
+    // Largest error a link may carry, as a fraction of the power the sources bring in.
+    double epsilon = 1e-4;
+    int maxSubdivision = 3;   // a triangle splits into at most 4^this patches
+    int visibilityRays = 8;   // per link (stratified pairs of points)
+    int directionLevel = 2;   // direction set of cluster light: 2 → 34 directions
+    double tolerance = 1e-5;  // iteration stops when the radiosity changes less than
+                              // this times its maximum
+    int maxIterations = 2000;
+    int threads = 0;  // 0: every core
+    // A continuous sky is discretised into these cones for the hierarchy's links.
+    SkyDiscretization skyCones = SkyDiscretization::kTurtle46;
+};
+
+Solution SolveHrc(const Scene& scene, const FlatScene& flat, const RayScene& rays,
+                  const HrcOptions& options);
+
+}  // namespace leaflux

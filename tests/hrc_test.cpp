@@ -1,0 +1,189 @@
+// The HRC solver against closed forms and against the Monte Carlo reference.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "solver/solve.h"
+#include "tests/scene_builders.h"
+
+namespace leaflux {
+namespace {
+using namespace leaflux::testing;
+
+Solution SolveWithHrc(const Scene& scene, const PreparedScene& prepared, double epsilon) {
+    SolverSettings settings;
+    settings.kind = SolverKind::kHrc;
+    settings.hrc.epsilon = epsilon;
+    return Solve(prepared, settings);
+}
+
+TEST(HrcPlate, UnderSunGetsSinOfElevationOnTop) {
+    Scene scene = OneBandScene({{"black", Leaf(0, 0)}});
+    scene.nodes.push_back(OrganNode(1, "plate", Rectangle(1, 1, 0), "black"));
+    scene.sources.suns.push_back(SunAt(30, 120, 1000));
+    scene.Validate();
+    const PreparedScene prepared(scene);
+    const Solution s = SolveWithHrc(scene, prepared, 1e-3);
+    EXPECT_NEAR(s.light[0][0].irradianceUpperWm2, 500.0, 1e-9);
+    EXPECT_NEAR(s.light[0][0].irradianceLowerWm2, 0.0, 1e-9);
+}
+
+TEST(HrcPlate, UnderDiscretisedSkyKeepsTheHorizontalIrradiance) {
+    Scene scene = OneBandScene({{"black", Leaf(0, 0)}});
+    scene.nodes.push_back(OrganNode(1, "plate", Rectangle(1, 1, 0), "black"));
+    scene.sources.skies.push_back({SkyModel::kCieOvercast, {300.0}, SkyDiscretization::kTurtle46});
+    scene.Validate();
+    const PreparedScene prepared(scene);
+    const Solution s = SolveWithHrc(scene, prepared, 1e-3);
+    // Each cone is a beam along its axis here: within the cap-mean cos factor of 300.
+    EXPECT_NEAR(s.light[0][0].irradianceUpperWm2, 300.0, 0.02 * 300.0);
+}
+
+struct ViewFactorCase {
+    const char* name;
+    std::shared_ptr<const Mesh> emitter, receiver;
+    double expected;
+};
+
+TEST(HrcViewFactor, MatchesHowellWithinOnePercent) {
+    const auto rect = [](double w, double h, double z, bool down) {
+        const glm::dvec3 a(0, 0, z), b(w, 0, z), c(w, h, z), d(0, h, z);
+        return down ? Quad(a, d, c, b) : Quad(a, b, c, d);
+    };
+    const ViewFactorCase cases[] = {
+        {"parallel_unit_gap_1", rect(1, 1, 0, false), rect(1, 1, 1, true), 0.199825},
+        {"parallel_unit_gap_0.1", rect(1, 1, 0, false), rect(1, 1, 0.1, true), 0.826995},
+        {"parallel_1x2_gap_0.5", rect(1, 2, 0, false), rect(1, 2, 0.5, true), 0.508989},
+        {"perpendicular_unit", Quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}),
+         Quad({0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}), 0.200044},
+    };
+    for (const ViewFactorCase& c : cases) {
+        Scene scene = OneBandScene({{"black", Leaf(0, 0)}});
+        scene.nodes.push_back(OrganNode(1, "receiver", c.receiver, "black"));
+        scene.sources.emitters.push_back({"lamp", c.emitter, {1000.0}, ""});
+        scene.Validate();
+        const PreparedScene prepared(scene);
+        const Solution s = SolveWithHrc(scene, prepared, 1e-4);
+        const double e = s.light[0][0].irradianceUpperWm2 + s.light[0][0].irradianceLowerWm2;
+        EXPECT_NEAR(e, 1000.0 * c.expected, 0.01 * 1000.0 * c.expected) << c.name;
+    }
+}
+
+}  // namespace
+}  // namespace leaflux
+
+namespace leaflux {
+namespace {
+using namespace leaflux::testing;
+
+// A closed cube whose inner faces emit E and reflect ρ: B = E / (1 − ρ) on every face.
+Scene HrcFurnace(double rho, double exitance) {
+    Scene scene = OneBandScene({{"wall", Opaque(rho)}});
+    const glm::dvec3 p[8] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                             {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    const int faces[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1},
+                             {1, 5, 6, 2}, {2, 6, 7, 3}, {3, 7, 4, 0}};
+    for (int f = 0; f < 6; ++f) {
+        scene.sources.emitters.push_back(
+            {"face" + std::to_string(f),
+             Quad(p[faces[f][0]], p[faces[f][1]], p[faces[f][2]], p[faces[f][3]]),
+             {exitance},
+             "wall"});
+    }
+    return scene;
+}
+
+// Hierarchical radiosity does not make form factors sum to one exactly; an excess δ comes
+// back as B = E / (1 − ρ(1 + δ)), so the error grows as 1/(1 − ρ): within 1 % for ρ ≤ 0.9
+// at ε = 1e-6, and for ρ = 0.99 (stiff) a converged, finite answer within 3 %.
+TEST(HrcFurnace, RadiosityIsEmittanceOverOneMinusRho) {
+    const double cases[][2] = {{0.5, 0.01}, {0.9, 0.01}, {0.99, 0.03}};
+    for (const auto& [rho, tolerance] : cases) {
+        SCOPED_TRACE(rho);
+        const Scene scene = HrcFurnace(rho, 10.0);
+        scene.Validate();
+        const PreparedScene prepared(scene);
+        const Solution s = SolveWithHrc(scene, prepared, 1e-6);
+        for (const auto& light : s.light) {
+            // Irradiance on the inner side equals the radiosity everywhere.
+            EXPECT_NEAR(light[0].irradianceUpperWm2, 10.0 / (1.0 - rho),
+                        tolerance * 10.0 / (1.0 - rho));
+        }
+        EXPECT_LE(s.stats.residual, 1e-5);
+        const EnergyBalance& e = s.balance[0];
+        EXPECT_NEAR(e.incidentW, e.absorbedW + e.escapedW, 0.005 * e.incidentW);
+    }
+}
+
+}  // namespace
+}  // namespace leaflux
+
+#include "solver/generator.h"
+
+namespace leaflux {
+namespace {
+
+// A 300-leaf generated tree under a sun and a Turtle-like sky, NIR-like leaves.
+Scene SmallTree(BandOptics leaf) {
+    Scene scene;
+    scene.bands = {{"NIR"}};
+    scene.optics = {{"leaf", {leaf}}, {"stem", {{0.4, 0.4, 0, 0}}}};
+    TreeParameters tree;
+    tree.leafCount = 300;
+    tree.seed = 11;
+    AddTree(scene, tree, {0, 0, 0});
+    scene.sources.suns.push_back({glm::normalize(glm::dvec3(0.3, -0.5, 0.8)), {500.0}, 0.0});
+    scene.sources.skies.push_back({SkyModel::kCieOvercast, {100.0}, SkyDiscretization::kTurtle46});
+    scene.Validate();
+    return scene;
+}
+
+// Mean relative error over leaves getting at least 5 % of the brightest leaf's light.
+double MeanRelativeError(const FlatScene& flat, const Solution& value, const Solution& reference) {
+    double largest = 0.0, sum = 0.0;
+    int count = 0;
+    auto total = [](const BandLight& l) { return l.irradianceUpperWm2 + l.irradianceLowerWm2; };
+    for (std::size_t r = 0; r < flat.receivers.size(); ++r)
+        largest = std::max(largest, total(reference.light[r][0]));
+    for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
+        const double expected = total(reference.light[r][0]);
+        if (flat.receivers[r].name.rfind("leaf", 0) != 0 || expected < 0.05 * largest) continue;
+        sum += std::abs(total(value.light[r][0]) - expected) / expected;
+        ++count;
+    }
+    return sum / count;
+}
+
+TEST(HrcTree, ErrorAgainstMonteCarloFallsWithEpsilon) {
+    const Scene scene = SmallTree({0.45, 0.45, 0.45, 0.45});
+    const PreparedScene prepared(scene);
+    SolverSettings mc;
+    mc.monteCarlo.samplesPerReceiver = 2048;
+    const Solution reference = Solve(prepared, mc);
+    double previous = 1e300;
+    for (double epsilon : {1e-3, 1e-4, 1e-5}) {
+        const Solution hrc = SolveWithHrc(scene, prepared, epsilon);
+        const double error = MeanRelativeError(prepared.Flat(), hrc, reference);
+        EXPECT_LT(error, previous) << "epsilon " << epsilon;
+        RecordProperty("mean_relative_error_at_" + std::to_string(epsilon), std::to_string(error));
+        previous = error;
+    }
+    // The bound for lit leaves (3 %); this tree measures 1.6 % at ε = 1e-5, with the
+    // reference's own noise (about 1 % a leaf at 2,048 paths) inside that.
+    EXPECT_LT(previous, 0.03);
+}
+
+TEST(HrcTree, StiffLeavesGiveAFiniteConvergedAnswer) {
+    const Scene scene = SmallTree({0.5, 0.5, 0.49, 0.49});
+    const PreparedScene prepared(scene);
+    const Solution hrc = SolveWithHrc(scene, prepared, 1e-4);
+    EXPECT_LE(hrc.stats.residual, 1e-5);
+    for (const auto& light : hrc.light) {
+        EXPECT_TRUE(std::isfinite(light[0].irradianceUpperWm2) &&
+                    std::isfinite(light[0].irradianceLowerWm2));
+        EXPECT_GE(light[0].irradianceUpperWm2, 0.0);
+    }
+}
+
+}  // namespace
+}  // namespace leaflux
