@@ -10,7 +10,7 @@ namespace leaflux {
 namespace {
 using namespace leaflux::testing;
 
-Solution SolveWithHrc(const Scene& scene, const PreparedScene& prepared, double epsilon) {
+Solution SolveWithHrc(const PreparedScene& prepared, double epsilon) {
     SolverSettings settings;
     settings.kind = SolverKind::kHrc;
     settings.hrc.epsilon = epsilon;
@@ -23,7 +23,7 @@ TEST(HrcPlate, UnderSunGetsSinOfElevationOnTop) {
     scene.sources.suns.push_back(SunAt(30, 120, 1000));
     scene.Validate();
     const PreparedScene prepared(scene);
-    const Solution s = SolveWithHrc(scene, prepared, 1e-3);
+    const Solution s = SolveWithHrc(prepared, 1e-3);
     EXPECT_NEAR(s.light[0][0].irradianceUpperWm2, 500.0, 1e-9);
     EXPECT_NEAR(s.light[0][0].irradianceLowerWm2, 0.0, 1e-9);
 }
@@ -34,7 +34,7 @@ TEST(HrcPlate, UnderDiscretisedSkyKeepsTheHorizontalIrradiance) {
     scene.sources.skies.push_back({SkyModel::kCieOvercast, {300.0}, SkyDiscretization::kTurtle46});
     scene.Validate();
     const PreparedScene prepared(scene);
-    const Solution s = SolveWithHrc(scene, prepared, 1e-3);
+    const Solution s = SolveWithHrc(prepared, 1e-3);
     // Each cone is a beam along its axis here: within the cap-mean cos factor of 300.
     EXPECT_NEAR(s.light[0][0].irradianceUpperWm2, 300.0, 0.02 * 300.0);
 }
@@ -63,7 +63,7 @@ TEST(HrcViewFactor, MatchesHowellWithinOnePercent) {
         scene.sources.emitters.push_back({"lamp", c.emitter, {1000.0}, ""});
         scene.Validate();
         const PreparedScene prepared(scene);
-        const Solution s = SolveWithHrc(scene, prepared, 1e-4);
+        const Solution s = SolveWithHrc(prepared, 1e-4);
         const double e = s.light[0][0].irradianceUpperWm2 + s.light[0][0].irradianceLowerWm2;
         EXPECT_NEAR(e, 1000.0 * c.expected, 0.01 * 1000.0 * c.expected) << c.name;
     }
@@ -103,7 +103,7 @@ TEST(HrcFurnace, RadiosityIsEmittanceOverOneMinusRho) {
         const Scene scene = HrcFurnace(rho, 10.0);
         scene.Validate();
         const PreparedScene prepared(scene);
-        const Solution s = SolveWithHrc(scene, prepared, 1e-6);
+        const Solution s = SolveWithHrc(prepared, 1e-6);
         for (const auto& light : s.light) {
             // Irradiance on the inner side equals the radiosity everywhere.
             EXPECT_NEAR(light[0].irradianceUpperWm2, 10.0 / (1.0 - rho),
@@ -162,7 +162,7 @@ TEST(HrcTree, ErrorAgainstMonteCarloFallsWithEpsilon) {
     const Solution reference = Solve(prepared, mc);
     double previous = 1e300;
     for (double epsilon : {1e-3, 1e-4, 1e-5}) {
-        const Solution hrc = SolveWithHrc(scene, prepared, epsilon);
+        const Solution hrc = SolveWithHrc(prepared, epsilon);
         const double error = MeanRelativeError(prepared.Flat(), hrc, reference);
         EXPECT_LT(error, previous) << "epsilon " << epsilon;
         RecordProperty("mean_relative_error_at_" + std::to_string(epsilon), std::to_string(error));
@@ -176,7 +176,7 @@ TEST(HrcTree, ErrorAgainstMonteCarloFallsWithEpsilon) {
 TEST(HrcTree, StiffLeavesGiveAFiniteConvergedAnswer) {
     const Scene scene = SmallTree({0.5, 0.5, 0.49, 0.49});
     const PreparedScene prepared(scene);
-    const Solution hrc = SolveWithHrc(scene, prepared, 1e-4);
+    const Solution hrc = SolveWithHrc(prepared, 1e-4);
     EXPECT_LE(hrc.stats.residual, 1e-5);
     for (const auto& light : hrc.light) {
         EXPECT_TRUE(std::isfinite(light[0].irradianceUpperWm2) &&

@@ -1,12 +1,23 @@
 #include "solver/radiosity/hierarchy.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <unordered_map>
 
 #include "solver/check.h"
 
 namespace leaflux {
+namespace {
+// Area centroid and RMS distance from it of a triangle: E|x − g|² = Σ|v − g|² / 12.
+void TriangleMoments(HrcNode& node) {
+    node.centroid = (node.a + node.b + node.c) / 3.0;
+    const double second = glm::dot(node.a - node.centroid, node.a - node.centroid) +
+                          glm::dot(node.b - node.centroid, node.b - node.centroid) +
+                          glm::dot(node.c - node.centroid, node.c - node.centroid);
+    node.spread = std::sqrt(second / 12.0);
+}
+}  // namespace
 
 Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat) : flat_(flat) {
     // Receivers first: one patch per triangle, grouped when an organ has several.
@@ -153,6 +164,7 @@ void Hierarchy::Finish(std::uint32_t index) {
             const glm::dvec3 hi = glm::max(node.a, glm::max(node.b, node.c));
             node.centre = 0.5 * (lo + hi);
             node.radius = 0.5 * glm::length(hi - lo);
+            TriangleMoments(node);
             continue;
         }
         if (!expanded) {
@@ -172,6 +184,18 @@ void Hierarchy::Finish(std::uint32_t index) {
             hi = glm::max(hi, c.centre + glm::dvec3(c.radius));
         }
         node.centre = 0.5 * (lo + hi);
+        node.centroid = glm::dvec3(0.0);
+        for (std::uint32_t child : node.children) {
+            node.centroid += nodes_[child].areaM2 / node.areaM2 * nodes_[child].centroid;
+        }
+        double second = 0.0;  // parallel axis theorem over the children
+        for (std::uint32_t child : node.children) {
+            const HrcNode& c = nodes_[child];
+            second += c.areaM2 / node.areaM2 *
+                      (c.spread * c.spread +
+                       glm::dot(c.centroid - node.centroid, c.centroid - node.centroid));
+        }
+        node.spread = std::sqrt(second);
         node.radius = 0.0;
         for (std::uint32_t child : node.children) {
             const HrcNode& c = nodes_[child];
@@ -205,6 +229,7 @@ bool Hierarchy::Subdivide(std::uint32_t index, double minAreaM2) {
         const glm::dvec3 hi = glm::max(child.a, glm::max(child.b, child.c));
         child.centre = 0.5 * (lo + hi);
         child.radius = 0.5 * glm::length(hi - lo);
+        TriangleMoments(child);
         nodes_.push_back(child);
         children.push_back(static_cast<std::uint32_t>(nodes_.size() - 1));
     }

@@ -30,10 +30,13 @@ struct HrcNode {
     std::uint32_t triangle = 0;
     std::uint32_t receiver = 0;
     int depth = 0;  // subdivision depth of a patch (0: a flat triangle)
-    // Every node: area (m²), bounding sphere, and its original triangles.
+    // Every node: area (m²), bounding sphere, area centroid and the RMS distance of its
+    // area from that centroid (m), and its original triangles.
     double areaM2 = 0.0;
     glm::dvec3 centre{0.0};
     double radius = 0.0;
+    glm::dvec3 centroid{0.0};
+    double spread = 0.0;
     std::uint32_t first = 0, count = 0;
 };
 

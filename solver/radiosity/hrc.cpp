@@ -39,8 +39,8 @@ Interpolation Locate(const DirectionSet& set, const glm::dvec3& direction) {
 
 // Light from a node S to a node R.
 struct NodeLink {
-    std::uint32_t sender;
-    bool exact;  // patch ← patch by the analytic form factor
+    std::uint32_t sender = 0;
+    bool exact = false;  // patch ← patch by the analytic form factor
     double formUpper = 0.0, formLower = 0.0, solidAngleSr = 0.0;
     int senderSide = kUpper;  // a patch sender: its side facing R
     // Cluster sender: v / d², times its intensity. Patch sender: v Ω / π, times its
@@ -310,11 +310,16 @@ class HrcSolver {
         int senderSide = kUpper;
         if (S.patch) {
             const glm::dvec3 centre = (S.a + S.b + S.c) / 3.0;
-            senderSide = glm::dot(S.normal, R.centre - centre) >= 0.0 ? kUpper : kLower;
-            const glm::dvec3 ra = glm::normalize(S.a - R.centre),
-                             rb = glm::normalize(S.b - R.centre),
-                             rc = glm::normalize(S.c - R.centre);
-            geometric = SphericalTriangleSolidAngle(ra, rb, rc) / kPi;
+            senderSide = glm::dot(S.normal, R.centroid - centre) >= 0.0 ? kUpper : kLower;
+            // The solid angle at R's centroid, with the same second-order correction for
+            // the spread of R's area as between clusters.
+            const glm::dvec3 ra = glm::normalize(S.a - R.centroid),
+                             rb = glm::normalize(S.b - R.centroid),
+                             rc = glm::normalize(S.c - R.centroid);
+            const double square =
+                std::max(glm::dot(centre - R.centroid, centre - R.centroid), 1e-300);
+            const double spread = std::min(R.spread * R.spread / (3.0 * square), 1.0);
+            geometric = SphericalTriangleSolidAngle(ra, rb, rc) / kPi * (1.0 + spread);
             double radiosity = 0.0;
             for (int b = 0; b < bands_; ++b) radiosity += radiosity_[s][senderSide][b];
             sender = radiosity * geometric * ProjectedArea(r, toSender);
@@ -322,8 +327,14 @@ class HrcSolver {
             geometricError =
                 std::min(1.0, std::pow((R.radius + S.radius) / std::max(d, 1e-300), 2.0));
         } else {
-            const double square = std::max(d * d, 0.25 * std::pow(R.radius + S.radius, 2.0));
-            geometric = 1.0 / square;
+            // 1/d² between centroids, times the mean of 1/|x − y|² over the two nodes' spread
+            // of area to second order, 1 + (σ_R² + σ_S²) / (3 d²): without it the transfer
+            // between near clusters is biased low (Jensen). Bounded for overlapping clusters.
+            const glm::dvec3 gap = S.centroid - R.centroid;
+            const double square =
+                std::max(glm::dot(gap, gap), 0.25 * std::pow(R.radius + S.radius, 2.0));
+            const double spread = (R.spread * R.spread + S.spread * S.spread) / (3.0 * square);
+            geometric = std::min(1.0 + spread, 2.0) / square;
             // The error bound does not trust the bounded transfer of overlapping clusters:
             // there, all the sender's power may land on the receiver.
             sender = Power(s, -toSender) * ProjectedArea(r, toSender) / std::max(d * d, 1e-300);
@@ -344,7 +355,9 @@ class HrcSolver {
                 return SplitAndRefine(r, s, !receiverLarger);
         }
         if (v <= 0.0) return;
-        NodeLink link{s, false};
+        NodeLink link;
+        link.sender = s;
+        link.exact = false;
         link.geometric = v * geometric;
         link.senderSide = senderSide;
         link.toSender = toSender;
@@ -377,7 +390,9 @@ class HrcSolver {
                 return SplitAndRefine(r, s, !receiverLarger);
         }
         if (v <= 0.0) return;
-        NodeLink link{s, true};
+        NodeLink link;
+        link.sender = s;
+        link.exact = true;
         link.formUpper = f.upper * v;
         link.formLower = f.lower * v;
         link.solidAngleSr = f.solidAngleSr * v;
