@@ -1,5 +1,6 @@
 // leaflux: the one-shot command line. `solve` lights a scene file, `generate` writes a
 // procedural tree or plantation as a scene file.
+#include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -201,6 +202,7 @@ int main(int argc, char** argv) {
     generateApp->add_option("--out", generate.out, "Scene file to write")->required();
 
     CLI11_PARSE(app, argc, argv);
+    spdlog::cfg::load_env_levels();  // SPDLOG_LEVEL=debug shows the solvers' phases
     try {
         if (solveApp->parsed()) return RunSolve(solve);
         if (generateApp->parsed()) return RunGenerate(generate);

@@ -1,5 +1,6 @@
 #include "solver/radiosity/hrc.h"
 
+#include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -24,8 +25,18 @@ constexpr int kUpper = 0, kLower = 1;
 // Spheres closer than this many radii cannot exchange light as points.
 constexpr double kNearFieldRatio = 1.5;
 
-using Spectrum = std::array<double, kMaxBands>;
-using Sided = std::array<Spectrum, 2>;
+class Stopwatch {
+  public:
+    double Lap() {
+        const auto now = std::chrono::steady_clock::now();
+        const double seconds = std::chrono::duration<double>(now - last_).count();
+        last_ = now;
+        return seconds;
+    }
+
+  private:
+    std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
 
 struct Interpolation {
     std::array<int, 3> index{};
@@ -55,15 +66,6 @@ struct SourceLink {
     double visibility;
 };
 
-struct DirectionalSource {
-    glm::dvec3 toward;
-    Spectrum normalIrradiance{};
-};
-
-struct SideOptics {
-    Spectrum rho[2]{}, tau[2]{};  // tau[s]: arriving on side s, leaving the other side
-};
-
 // How uncertain a visibility estimated from n rays is, as 2√(v(1−v)) with v taken by
 // Laplace's rule, (visible + 1) / (n + 2): never zero, since eight rays that all pass do
 // not prove that nothing is in the way.
@@ -72,8 +74,24 @@ double VisibilitySpread(double visible, int rays) {
     return 2.0 * std::sqrt(v * (1.0 - v));
 }
 
+// The solver for a number of bands fixed at compile time, so that per-node spectra take
+// exactly the room they need.
+template <int kBands>
 class HrcSolver {
   public:
+    using Spectrum = std::array<double, kBands>;
+    using Sided = std::array<Spectrum, 2>;
+    using Moment = std::array<glm::dvec3, kBands>;
+
+    struct DirectionalSource {
+        glm::dvec3 toward;
+        Spectrum normalIrradiance{};
+    };
+
+    struct SideOptics {
+        Spectrum rho[2]{}, tau[2]{};  // tau[s]: arriving on side s, leaving the other side
+    };
+
     HrcSolver(const Scene& scene, const FlatScene& flat, const RayScene& rays,
               const HrcOptions& options)
         : scene_(scene),
@@ -407,7 +425,17 @@ class HrcSolver {
     void Index();
     void PullUp();
     void Gather();
+    // Light gathered by a node and its ancestors, handed down to the patches.
+    struct Level {
+        std::vector<double> bins;     // [bin][band], normal irradiance
+        std::vector<double> sources;  // visibility, per directional source
+        Sided sides{};
+        Spectrum integral{};
+        Moment moment{};
+    };
+    void Accumulate(std::uint32_t n, bool sourcesOnly, Level& level) const;
     void PushDown(bool sourcesOnly);
+    void PushSubtree(std::uint32_t start, const Level& above, bool sourcesOnly);
     double UpdateRadiosity();
     void Outputs(Solution& solution);
 
@@ -435,17 +463,18 @@ class HrcSolver {
     std::vector<double> gatheredBins_;        // [slot][bin][band], W/m² normal
     std::vector<Sided> gatheredSides_;        // patches: W/m² per side
     std::vector<Spectrum> gatheredIntegral_;  // patches: ∫ L dω
-    std::vector<std::array<glm::dvec3, kMaxBands>> gatheredMoment_;
+    std::vector<Moment> gatheredMoment_;
     std::vector<std::uint32_t> preOrder_;   // parents before children
     std::vector<std::uint32_t> receivers_;  // nodes with links
     // Leaf patches: the light of the last push.
     std::vector<Sided> irradiance_, direct_;
     std::vector<Spectrum> integral_;
-    std::vector<std::array<glm::dvec3, kMaxBands>> moment_;
+    std::vector<Moment> moment_;
     std::vector<Spectrum> emission_;  // exitance of emitter patches
 };
 
-void HrcSolver::Index() {
+template <int kBands>
+void HrcSolver<kBands>::Index() {
     preOrder_.clear();
     std::vector<std::uint32_t> stack = {hierarchy_.Root()};
     while (!stack.empty()) {
@@ -501,7 +530,8 @@ void HrcSolver::Index() {
     }
 }
 
-void HrcSolver::PullUp() {
+template <int kBands>
+void HrcSolver<kBands>::PullUp() {
     emitted_.assign(hierarchy_.Size(), 0.0);
     for (auto it = preOrder_.rbegin(); it != preOrder_.rend(); ++it) {
         const std::uint32_t n = *it;
@@ -543,7 +573,8 @@ void HrcSolver::PullUp() {
     }
 }
 
-void HrcSolver::Gather() {
+template <int kBands>
+void HrcSolver<kBands>::Gather() {
     tbb::parallel_for(std::size_t{0}, receivers_.size(), [&](std::size_t i) {
         const std::uint32_t r = receivers_[i];
         const HrcNode& R = hierarchy_[r];
@@ -596,56 +627,49 @@ void HrcSolver::Gather() {
     });
 }
 
-void HrcSolver::PushDown(bool sourcesOnly) {
+template <int kBands>
+void HrcSolver<kBands>::Accumulate(std::uint32_t n, bool sourcesOnly, Level& level) const {
+    const HrcNode& node = hierarchy_[n];
+    for (const SourceLink& link : sourceLinks_[n]) level.sources[link.source] += link.visibility;
+    if (sourcesOnly) return;
+    if (node.patch) {
+        for (int k = 0; k < bands_; ++k) {
+            level.sides[kUpper][k] += gatheredSides_[n][kUpper][k];
+            level.sides[kLower][k] += gatheredSides_[n][kLower][k];
+            level.integral[k] += gatheredIntegral_[n][k];
+            level.moment[k] += gatheredMoment_[n][k];
+        }
+    } else {
+        const double* in = &gatheredBins_[static_cast<std::size_t>(slot_[n]) * bins_ * bands_];
+        for (int i = 0; i < bins_ * bands_; ++i) level.bins[i] += in[i];
+    }
+}
+
+template <int kBands>
+void HrcSolver<kBands>::PushDown(bool sourcesOnly) {
+    // What the root gathered, then each of its subtrees in parallel: they share nothing.
+    Level top{std::vector<double>(bins_ * bands_, 0.0), std::vector<double>(sources_.size(), 0.0)};
+    const std::uint32_t root = hierarchy_.Root();
+    if (hierarchy_[root].patch) return PushSubtree(root, top, sourcesOnly);
+    Accumulate(root, sourcesOnly, top);
+    const auto& children = hierarchy_[root].children;
+    tbb::parallel_for(std::size_t{0}, children.size(),
+                      [&](std::size_t i) { PushSubtree(children[i], top, sourcesOnly); });
+}
+
+template <int kBands>
+void HrcSolver<kBands>::PushSubtree(std::uint32_t start, const Level& above, bool sourcesOnly) {
     // Depth-first with one accumulator per depth: what every ancestor gathered.
-    struct Level {
-        std::vector<double> bins;     // [bin][band]
-        std::vector<double> sources;  // visibility-weighted, per source
-        Sided sides{};
-        Spectrum integral{};
-        std::array<glm::dvec3, kMaxBands> moment{};
-    };
-    std::vector<Level> levels;
-    std::vector<std::pair<std::uint32_t, int>> stack = {{hierarchy_.Root(), 0}};
+    std::vector<Level> levels = {above};
+    std::vector<std::pair<std::uint32_t, int>> stack = {{start, 1}};
     while (!stack.empty()) {
         const auto [n, depth] = stack.back();
         stack.pop_back();
-        if (static_cast<int>(levels.size()) <= depth) {
-            levels.push_back({std::vector<double>(bins_ * bands_, 0.0),
-                              std::vector<double>(sources_.size(), 0.0)});
-        }
+        if (static_cast<int>(levels.size()) <= depth) levels.push_back(levels.front());
         Level& level = levels[depth];
-        if (depth == 0) {
-            std::fill(level.bins.begin(), level.bins.end(), 0.0);
-            std::fill(level.sources.begin(), level.sources.end(), 0.0);
-            level.sides = Sided{};
-            level.integral = Spectrum{};
-            level.moment = {};
-        } else {
-            const Level& parent = levels[depth - 1];
-            level.bins = parent.bins;
-            level.sources = parent.sources;
-            level.sides = parent.sides;
-            level.integral = parent.integral;
-            level.moment = parent.moment;
-        }
+        level = levels[depth - 1];
+        Accumulate(n, sourcesOnly, level);
         const HrcNode& node = hierarchy_[n];
-        for (const SourceLink& link : sourceLinks_[n])
-            level.sources[link.source] += link.visibility;
-        if (!sourcesOnly) {
-            if (node.patch) {
-                for (int k = 0; k < bands_; ++k) {
-                    level.sides[kUpper][k] += gatheredSides_[n][kUpper][k];
-                    level.sides[kLower][k] += gatheredSides_[n][kLower][k];
-                    level.integral[k] += gatheredIntegral_[n][k];
-                    level.moment[k] += gatheredMoment_[n][k];
-                }
-            } else {
-                const double* in =
-                    &gatheredBins_[static_cast<std::size_t>(slot_[n]) * bins_ * bands_];
-                for (int i = 0; i < bins_ * bands_; ++i) level.bins[i] += in[i];
-            }
-        }
         if (!node.patch || !node.children.empty()) {
             for (std::uint32_t child : node.children) stack.push_back({child, depth + 1});
             continue;
@@ -683,7 +707,8 @@ void HrcSolver::PushDown(bool sourcesOnly) {
     }
 }
 
-double HrcSolver::UpdateRadiosity() {
+template <int kBands>
+double HrcSolver<kBands>::UpdateRadiosity() {
     double change = 0.0, largest = 0.0;
     for (std::uint32_t n : preOrder_) {
         const HrcNode& node = hierarchy_[n];
@@ -704,7 +729,8 @@ double HrcSolver::UpdateRadiosity() {
     return largest > 0.0 ? change / largest : 0.0;
 }
 
-void HrcSolver::Solve(Solution& solution) {
+template <int kBands>
+void HrcSolver<kBands>::Solve(Solution& solution) {
     Grow();
     Index();
     for (std::uint32_t n : preOrder_) radiosity_[n][kUpper] = emission_[n];
@@ -719,14 +745,17 @@ void HrcSolver::Solve(Solution& solution) {
     }
     if (totalPower_ <= 0.0) return Outputs(solution);
 
+    Stopwatch clock;
     for (std::uint32_t s = 0; s < sources_.size(); ++s) RefineSource(hierarchy_.Root(), s);
     // Direct light first, so that links are refined on what senders will send.
     Index();
     PushDown(true);
     UpdateRadiosity();
     PullUp();
+    const double sourceSeconds = clock.Lap();
     RefineSelf(hierarchy_.Root());
     Index();
+    const double refineSeconds = clock.Lap();
 
     // Jacobi from the emission: the first sweep's light is the direct light.
     for (std::uint32_t n : preOrder_) radiosity_[n] = Sided{}, radiosity_[n][kUpper] = emission_[n];
@@ -743,10 +772,15 @@ void HrcSolver::Solve(Solution& solution) {
     }
     solution.stats.iterations = iteration + 1;
     solution.stats.residual = residual;
+    const double solveSeconds = clock.Lap();
     Outputs(solution);
+    spdlog::debug(
+        "hrc: source links {:.3f} s, refinement {:.3f} s, {} iterations {:.3f} s, outputs {:.3f} s",
+        sourceSeconds, refineSeconds, iteration + 1, solveSeconds, clock.Lap());
 }
 
-void HrcSolver::Outputs(Solution& solution) {
+template <int kBands>
+void HrcSolver<kBands>::Outputs(Solution& solution) {
     std::size_t links = 0;
     for (const auto& l : links_) links += l.size();
     for (const auto& l : sourceLinks_) links += l.size();
@@ -764,7 +798,9 @@ void HrcSolver::Outputs(Solution& solution) {
         SetFlushToZero();
         const HrcNode& node = hierarchy_[leaves[i]];
         Random random(StreamSeed(0xE5C, leaves[i]));
-        const int count = 2 * options_.visibilityRays;
+        // A few stratified rays a side: the estimate is unbiased and only its sum over
+        // the scene matters (the escaped power of the energy balance).
+        const int count = std::max(2, options_.visibilityRays / 2);
         for (int s : {kUpper, kLower}) {
             int out = 0;
             for (int k = 0; k < count; ++k) {
@@ -822,7 +858,25 @@ void HrcSolver::Outputs(Solution& solution) {
 Solution SolveHrc(const Scene& scene, const FlatScene& flat, const RayScene& rays,
                   const HrcOptions& options) {
     LEAFLUX_CHECK(options.directionLevel >= 0 && options.directionLevel <= 4);
-    return HrcSolver(scene, flat, rays, options).Run();
+    switch (scene.bands.size()) {
+        case 1:
+            return HrcSolver<1>(scene, flat, rays, options).Run();
+        case 2:
+            return HrcSolver<2>(scene, flat, rays, options).Run();
+        case 3:
+            return HrcSolver<3>(scene, flat, rays, options).Run();
+        case 4:
+            return HrcSolver<4>(scene, flat, rays, options).Run();
+        case 5:
+            return HrcSolver<5>(scene, flat, rays, options).Run();
+        case 6:
+            return HrcSolver<6>(scene, flat, rays, options).Run();
+        case 7:
+            return HrcSolver<7>(scene, flat, rays, options).Run();
+        case 8:
+            return HrcSolver<8>(scene, flat, rays, options).Run();
+    }
+    throw InternalError("hrc: a scene has 1 to " + std::to_string(kMaxBands) + " bands");
 }
 
 }  // namespace leaflux
