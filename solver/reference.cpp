@@ -208,7 +208,7 @@ struct Tally {
     Spectrum direct[2]{};  // the part that came straight from a source
     Spectrum radianceIntegral{};
     std::array<glm::dvec3, kMaxBands> radianceMoment{};
-    double escape[2]{};  // cosine-weighted fraction of each side's view that escapes
+    Spectrum escaping{};  // radiosity leaving towards nothing (W/m²), emission aside
 };
 
 // How the path tracer draws directions at a point, for the MIS weights of lamps.
@@ -249,9 +249,10 @@ class PathTracer {
                                        (i / side + random.Uniform()) / side);
             const glm::dvec3& normal = flat_.triangles[x.triangle].normal;
             const SourceLight events = SourceEvents(x, normal, kUniformSphere, random, rays);
+            Spectrum here[2]{};  // this sample's irradiance estimate, per side
             for (int s : {kUpper, kLower}) {
                 for (int b = 0; b < bands; ++b) {
-                    tally.irradiance[s][b] += events.irradiance[s][b];
+                    here[s][b] += events.irradiance[s][b];
                     tally.direct[s][b] += events.irradiance[s][b];
                 }
             }
@@ -269,12 +270,30 @@ class PathTracer {
             bool escaped = false;
             Incoming(x, omega, random, rays, radiance, direct, escaped);
             for (int b = 0; b < bands; ++b) {
-                tally.irradiance[s][b] += 4.0 * kPi * radiance[b] * std::abs(cosine);
+                here[s][b] += 4.0 * kPi * radiance[b] * std::abs(cosine);
                 tally.direct[s][b] += 4.0 * kPi * direct[b] * std::abs(cosine);
                 tally.radianceIntegral[b] += 4.0 * kPi * radiance[b];
                 tally.radianceMoment[b] += 4.0 * kPi * radiance[b] * omega;
             }
-            if (escaped) tally.escape[s] += 4.0 * std::abs(cosine);
+            for (int b = 0; b < bands; ++b) {
+                tally.irradiance[kUpper][b] += here[kUpper][b];
+                tally.irradiance[kLower][b] += here[kLower][b];
+            }
+            // Escape, for the energy balance: the radiosity this sample estimates for one
+            // side (picked with probability 1/2) times whether an independent
+            // cosine-weighted direction leaves the scene — unbiased, as the two estimates
+            // are independent at the point.
+            const int leaving = random.Uniform() < 0.5 ? kUpper : kLower;
+            const glm::dvec3 out = CosineHemisphere(leaving == kUpper ? normal : -normal,
+                                                    random.Uniform(), random.Uniform());
+            ++rays;
+            if (rays_.Trace(x, out).fate != RayFate::kHit) {
+                const SideOptics& o = optics_[receiverIndex];
+                for (int b = 0; b < bands; ++b) {
+                    tally.escaping[b] += 2.0 * (o.rho[leaving][b] * here[leaving][b] +
+                                                o.tau[1 - leaving][b] * here[1 - leaving][b]);
+                }
+            }
         }
         for (int b = 0; b < bands; ++b) {
             for (int s : {kUpper, kLower}) {
@@ -283,9 +302,8 @@ class PathTracer {
             }
             tally.radianceIntegral[b] /= count;
             tally.radianceMoment[b] /= static_cast<double>(count);
+            tally.escaping[b] /= count;
         }
-        tally.escape[kUpper] /= count;
-        tally.escape[kLower] /= count;
         return tally;
     }
 
@@ -491,21 +509,14 @@ Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScen
             for (int b = 0; b < bands; ++b) {
                 auto& [upper, lower, absorb, in, out, rest] = series[b];
                 BandLight& light = solution.light[r][b];
-                for (std::size_t k = 0; k < tallies.size(); ++k) {
-                    const Tally& t = tallies[k];
-                    // Escape: radiosity times the escaping view fraction, the latter from the
-                    // next replicate so that the product of the two estimates is unbiased.
-                    const Tally& view = tallies[(k + 1) % tallies.size()];
-                    double absorbedW = 0.0, escapedW = 0.0, incidentW = 0.0;
+                for (const Tally& t : tallies) {
+                    double absorbedW = 0.0, incidentW = 0.0;
                     for (int s : {kUpper, kLower}) {
-                        const double e = t.irradiance[s][b];
-                        absorbedW += (1.0 - optics.rho[s][b] - optics.tau[s][b]) * e;
-                        // Radiosity of side s (emission aside): ρ_s E_s + τ_other→s E_other.
-                        const double radiosity =
-                            optics.rho[s][b] * e + optics.tau[1 - s][b] * t.irradiance[1 - s][b];
-                        escapedW += radiosity * view.escape[s];
+                        absorbedW +=
+                            (1.0 - optics.rho[s][b] - optics.tau[s][b]) * t.irradiance[s][b];
                         incidentW += t.direct[s][b];
                     }
+                    const double escapedW = t.escaping[b];
                     upper.push_back(t.irradiance[kUpper][b]);
                     lower.push_back(t.irradiance[kLower][b]);
                     absorb.push_back(absorbedW * receiver.areaM2);

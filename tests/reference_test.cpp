@@ -180,13 +180,13 @@ TEST(Furnace, RadiosityIsEmittanceOverOneMinusRho) {
         for (int f = 0; f < 6; ++f) {
             const BandLight& light = solved.Of("face" + std::to_string(f));
             ExpectWithin(light.irradianceUpperWm2, exitance / (1.0 - rho), light.stderrUpperWm2);
-            // Outside the box is dark, but for rays that leave a face at a shared edge and
-            // graze the next face in float rounding: 1e-30 W/m² and the like.
-            EXPECT_NEAR(light.irradianceLowerWm2, 0.0, 1e-12 * exitance);
+            // Outside the box is dark, but for rays that leave a face at a shared edge and,
+            // in single-precision traversal, graze into the box: a few 1e-8 of the inside.
+            EXPECT_NEAR(light.irradianceLowerWm2, 0.0, 1e-6 * exitance / (1.0 - rho));
         }
         // Closed: nothing escapes and all that arrives is absorbed, in expectation.
         const EnergyBalance& balance = solved.solution.balance[0];
-        EXPECT_NEAR(balance.escapedW, 0.0, 1e-12 * balance.incidentW);
+        EXPECT_NEAR(balance.escapedW, 0.0, 1e-6 * balance.incidentW);
         EXPECT_NEAR(balance.incidentW - balance.absorbedW, 0.0, kSigmas * balance.stderrW);
     }
 }

@@ -22,8 +22,6 @@ namespace {
 
 constexpr double kPi = glm::pi<double>();
 constexpr int kUpper = 0, kLower = 1;
-// Spheres closer than this many radii cannot exchange light as points.
-constexpr double kNearFieldRatio = 1.5;
 
 class Stopwatch {
   public:
@@ -256,9 +254,10 @@ class HrcSolver {
         HrcNode& node = hierarchy_[n];
         if (!node.patch) return true;
         if (!node.children.empty()) return true;
-        if (node.depth >= options_.maxSubdivision) return false;
+        const int deepest = options_.maxSubdivision;
+        if (node.depth >= deepest) return false;
         const double minArea =
-            flat_.triangles[node.triangle].areaM2 / std::pow(4.0, options_.maxSubdivision) * 0.999;
+            flat_.triangles[node.triangle].areaM2 / std::pow(4.0, deepest) * 0.999;
         if (!hierarchy_.Subdivide(n, minArea)) return false;
         Grow();
         for (std::uint32_t child : hierarchy_[n].children) {
@@ -360,6 +359,13 @@ class HrcSolver {
                 std::min(1.0, std::pow(R.radius + S.radius, 2.0) / std::max(d * d, 1e-300));
         }
         sender = std::min(sender, emitted_[s]);
+        // Overlapping bounds: the direction between centroids says nothing (two leaves face
+        // to face 1 µm apart have their centroids side by side), so any of the sender's
+        // power may reach the receiver.
+        if (glm::length(S.centroid - R.centroid) < R.radius + S.radius) {
+            sender = emitted_[s];
+            geometricError = 1.0;
+        }
         // A sender still dark after the direct light is linked where it stands: it may
         // light up as light bounces, and dropping it would lose that light.
         const double v = Visibility(r, s);
@@ -390,14 +396,17 @@ class HrcSolver {
         const HrcNode& S = hierarchy_[s];
         const glm::dvec3 x = (R.a + R.b + R.c) / 3.0;
         const SidedFormFactor f = PointToTriangle(x, R.normal, S.a, S.b, S.c);
-        if (f.upper + f.lower <= 0.0) return;
         const int senderSide =
             glm::dot(S.normal, x - (S.a + S.b + S.c) / 3.0) >= 0.0 ? kUpper : kLower;
         double radiosity = 0.0;
         for (int b = 0; b < bands_; ++b) radiosity += radiosity_[s][senderSide][b];
-        const double unoccluded = radiosity * (f.upper + f.lower) * R.areaM2;
+        const double d = std::max(glm::length(S.centroid - R.centroid), 1e-300);
+        // The form factor at R's centroid speaks for all of R only when R is small against
+        // the distance; otherwise parts of R may see S fully (F up to 1 on each side).
+        const bool near = R.radius > 0.5 * d;
+        if (!near && f.upper + f.lower <= 0.0) return;
+        const double unoccluded = radiosity * (near ? 1.0 : f.upper + f.lower) * R.areaM2;
         const double v = Visibility(r, s);
-        const double d = std::max(glm::length(S.centre - R.centre), 1e-300);
         const double error = unoccluded * (std::pow(R.radius / d, 2.0) +
                                            VisibilitySpread(v, options_.visibilityRays));
         if (error > options_.epsilon * totalPower_) {
@@ -407,7 +416,7 @@ class HrcSolver {
             if (receiverLarger ? Splittable(s) : Splittable(r))
                 return SplitAndRefine(r, s, !receiverLarger);
         }
-        if (v <= 0.0) return;
+        if (v <= 0.0 || f.upper + f.lower <= 0.0) return;
         NodeLink link;
         link.sender = s;
         link.exact = true;
