@@ -1,9 +1,27 @@
 #include "solver/light.h"
 
+#include <chrono>
 #include <cmath>
 #include <unordered_map>
 
+#include "solver/memory.h"
+
 namespace leaflux {
+
+namespace {
+double WallSeconds() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+}
+}  // namespace
+
+ResourceClock::ResourceClock() : wallStart_(WallSeconds()), cpuStart_(CpuSeconds()) {}
+
+void ResourceClock::Stamp(SolveStats& stats) const {
+    stats.wallSeconds = WallSeconds() - wallStart_;
+    stats.cpuSeconds = CpuSeconds() - cpuStart_;
+    stats.peakRssBytes = PeakRssBytes();
+}
 
 std::vector<StructureLight> AggregateStructures(const Scene& scene, const FlatScene& flat,
                                                 const Solution& solution) {

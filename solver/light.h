@@ -57,6 +57,16 @@ struct SolveStats {
     double residual = 0.0;  // last relative change of the radiosity
 };
 
+// Wall and CPU time and peak memory of a solve, from its start to Stamp.
+class ResourceClock {
+  public:
+    ResourceClock();
+    void Stamp(SolveStats& stats) const;
+
+  private:
+    double wallStart_, cpuStart_;
+};
+
 struct Solution {
     std::vector<std::vector<BandLight>> light;  // [receiver][band]
     std::vector<EnergyBalance> balance;         // [band]

@@ -473,8 +473,7 @@ Estimate Combine(const std::vector<double>& values) {
 Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScene& rays,
                         const ReferenceOptions& options) {
     LEAFLUX_CHECK(options.replicates >= 2);
-    const auto wallStart = std::chrono::steady_clock::now();
-    const double cpuStart = CpuSeconds();
+    const ResourceClock clock;
     const int bands = static_cast<int>(scene.bands.size());
     const auto receivers = static_cast<std::uint32_t>(flat.receivers.size());
     const int perReplicate =
@@ -564,10 +563,7 @@ Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScen
         }
         balance.stderrW = std::sqrt(variance);
     }
-    solution.stats.wallSeconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
-    solution.stats.cpuSeconds = CpuSeconds() - cpuStart;
-    solution.stats.peakRssBytes = PeakRssBytes();
+    clock.Stamp(solution.stats);
     solution.stats.rays = rayCount;
     solution.stats.threads = threads;
     return solution;

@@ -124,8 +124,7 @@ class HrcSolver {
     }
 
     Solution Run() {
-        const auto start = std::chrono::steady_clock::now();
-        const double cpuStart = CpuSeconds();
+        const ResourceClock clock;
         Solution solution;
         solution.light.assign(flat_.receivers.size(), std::vector<BandLight>(bands_));
         solution.balance.assign(bands_, EnergyBalance{});
@@ -135,10 +134,7 @@ class HrcSolver {
         if (hierarchy_.Root() != kNoNode) {
             arena.execute([&] { Solve(solution); });
         }
-        solution.stats.wallSeconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        solution.stats.cpuSeconds = CpuSeconds() - cpuStart;
-        solution.stats.peakRssBytes = PeakRssBytes();
+        clock.Stamp(solution.stats);
         solution.stats.threads = threads;
         solution.stats.rays = rayCount_;
         return solution;
