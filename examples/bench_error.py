@@ -15,8 +15,7 @@ import re
 import subprocess
 import sys
 
-LIT = 0.05  # a leaf is lit when it gets 5 % of the brightest leaf's light
-
+from compare import errors, load
 
 def run(cmd):
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
@@ -26,26 +25,6 @@ def run(cmd):
     peak = float(re.search(r"peak ([0-9]+) MiB", line).group(1))
     residuals = re.findall(r"(\w+): incident [^;]*residual ([-0-9.e+]+) %", line)
     return wall, cpu, peak, {band: float(r) for band, r in residuals}
-
-
-def load(path):
-    values = {}
-    for row in csv.DictReader(open(path)):
-        if not row["organ"].startswith("leaf"):
-            continue
-        total = float(row["irradiance_upper_wm2"]) + float(row["irradiance_lower_wm2"])
-        values[(row["organ"], row["band"])] = total
-    return values
-
-
-def errors(reference, value, band):
-    keys = [k for k in reference if k[1] == band]
-    largest = max(reference[k] for k in keys)
-    l2 = math.sqrt(sum((value[k] - reference[k]) ** 2 for k in keys) / len(keys)) / largest
-    relative = sorted(abs(value[k] - reference[k]) / reference[k] for k in keys if reference[k] >= LIT * largest)
-    mean = sum(relative) / len(relative)
-    p95 = relative[min(len(relative) - 1, int(0.95 * len(relative)))]
-    return 100 * l2, 100 * mean, 100 * p95
 
 
 def main():
@@ -60,11 +39,9 @@ def main():
     rows = []
     for leaves in [int(n) for n in args.leaves.split(",")]:
         scene = os.path.join(args.out, f"tree{leaves}.scene.txtpb")
-        subprocess.run([leaflux, "generate", "--leaves", str(leaves), "--seed", "2", "--out", scene],
-                       check=True, capture_output=True)
         # Both solvers see the same 46-cone sky, so the error is the solver's alone.
-        text = open(scene).read().replace("SKY_DISCRETIZATION_CONTINUOUS", "SKY_DISCRETIZATION_TURTLE_46")
-        open(scene, "w").write(text)
+        subprocess.run([leaflux, "generate", "--leaves", str(leaves), "--seed", "2", "--sky-cones", "turtle46",
+                        "--out", scene], check=True, capture_output=True)
         reference = os.path.join(args.out, f"tree{leaves}_reference.csv")
         if not os.path.exists(reference):  # the reference is cached: delete it to redo it
             run([leaflux, "solve", "--scene", scene, "--solver", "mc", "--samples",

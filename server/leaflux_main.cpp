@@ -80,8 +80,17 @@ struct GenerateCommand {
     double spacing = 6.0, rowAzimuth = 0.0, sunElevation = 50.0, sunAzimuth = 160.0;
     double sunPar = 400.0, sunNir = 350.0, skyPar = 100.0, skyNir = 60.0;
     bool noSky = false;
+    std::string skyCones = "continuous";
     std::string out;
 };
+
+SkyDiscretization SkyDiscretizationNamed(const std::string& name) {
+    if (name == "turtle46") return SkyDiscretization::kTurtle46;
+    if (name == "tetra34") return SkyDiscretization::kTetra34;
+    if (name == "tetra130") return SkyDiscretization::kTetra130;
+    if (name == "tetra514") return SkyDiscretization::kTetra514;
+    return SkyDiscretization::kContinuous;
+}
 
 // PAR- and NIR-like optics (leaf ρ, τ), a sun and a CIE overcast sky: a scene ready to solve.
 int RunGenerate(const GenerateCommand& command) {
@@ -197,6 +206,11 @@ int main(int argc, char** argv) {
     generateApp->add_option("--sun-azimuth", generate.sunAzimuth,
                             "Sun azimuth from north, clockwise (deg)");
     generateApp->add_flag("--no-sky", generate.noSky, "Sun only, no diffuse sky");
+    generateApp
+        ->add_option(
+            "--sky-cones", generate.skyCones,
+            "Sky as continuous radiance or as cones (every solver then sees the same cones)")
+        ->check(CLI::IsMember({"continuous", "turtle46", "tetra34", "tetra130", "tetra514"}));
     generateApp->add_flag("!--internodes", generate.tree.internodes,
                           "No internode geometry (leaves only)");
     generateApp->add_option("--out", generate.out, "Scene file to write")->required();

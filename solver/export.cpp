@@ -95,7 +95,8 @@ std::string Summary(const std::string& solver, const Scene& scene, const FlatSce
          << " MiB, " << stats.rays << " rays";
     if (stats.links > 0) {
         text << ", " << stats.links << " links, " << stats.elements << " elements, "
-             << stats.iterations << " iterations, residual " << Number(stats.residual);
+             << stats.refinementDepth << " levels, " << stats.iterations << " iterations, residual "
+             << Number(stats.residual);
     }
     for (std::size_t b = 0; b < solution.balance.size(); ++b) {
         const EnergyBalance& e = solution.balance[b];

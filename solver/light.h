@@ -53,6 +53,7 @@ struct SolveStats {
     // Deterministic solvers: the hierarchy and the iteration.
     std::int64_t links = 0;
     std::int64_t elements = 0;
+    int refinementDepth = 0;  // deepest level of the hierarchy that links reach
     int iterations = 0;
     double residual = 0.0;  // last relative change of the radiosity
 };

@@ -1,7 +1,9 @@
 #include "solver/radiosity/hrc.h"
 
 #include <spdlog/spdlog.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -429,6 +431,19 @@ class HrcSolver {
     void Solve(Solution& solution);
     void Index();
     void PullUp();
+    void PullNode(std::uint32_t n);
+    // Levels from the root to the deepest node with a link.
+    std::size_t Depth() const {
+        std::vector<std::size_t> depth(hierarchy_.Size(), 0);
+        std::size_t deepest = 0;
+        for (std::uint32_t n : preOrder_) {
+            const std::uint32_t parent = hierarchy_[n].parent;
+            if (parent != kNoNode) depth[n] = depth[parent] + 1;
+            if (!links_[n].empty() || !sourceLinks_[n].empty())
+                deepest = std::max(deepest, depth[n]);
+        }
+        return deepest;
+    }
     void Gather();
     // Light gathered by a node and its ancestors, handed down to the patches.
     struct Level {
@@ -469,8 +484,10 @@ class HrcSolver {
     std::vector<Sided> gatheredSides_;        // patches: W/m² per side
     std::vector<Spectrum> gatheredIntegral_;  // patches: ∫ L dω
     std::vector<Moment> gatheredMoment_;
-    std::vector<std::uint32_t> preOrder_;   // parents before children
-    std::vector<std::uint32_t> receivers_;  // nodes with links
+    std::vector<std::uint32_t> preOrder_;                        // parents before children
+    std::vector<std::pair<std::size_t, std::size_t>> subtrees_;  // the root's, in preOrder_
+    std::vector<std::uint32_t> leaves_;                          // leaf patches
+    std::vector<std::uint32_t> receivers_;                       // nodes with links
     // Leaf patches: the light of the last push.
     std::vector<Sided> irradiance_, direct_;
     std::vector<Spectrum> integral_;
@@ -490,6 +507,17 @@ void HrcSolver<kBands>::Index() {
         for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);
     }
     Grow();
+    subtrees_.clear();
+    leaves_.clear();
+    for (std::size_t i = 1; i < preOrder_.size(); ++i) {
+        const std::uint32_t n = preOrder_[i];
+        if (hierarchy_[n].parent == preOrder_.front()) {
+            if (!subtrees_.empty()) subtrees_.back().second = i;
+            subtrees_.push_back({i, preOrder_.size()});
+        }
+        if (hierarchy_[n].patch && hierarchy_[n].children.empty()) leaves_.push_back(n);
+    }
+    if (preOrder_.size() == 1 && hierarchy_[preOrder_[0]].patch) leaves_.push_back(preOrder_[0]);
     if (slot_.empty()) {
         // Clusters never change after construction: their slots and projected areas once.
         slot_.assign(hierarchy_.Size(), kNoNode);
@@ -537,43 +565,52 @@ void HrcSolver<kBands>::Index() {
 
 template <int kBands>
 void HrcSolver<kBands>::PullUp() {
-    emitted_.assign(hierarchy_.Size(), 0.0);
-    for (auto it = preOrder_.rbegin(); it != preOrder_.rend(); ++it) {
-        const std::uint32_t n = *it;
-        const HrcNode& node = hierarchy_[n];
-        if (node.patch && node.children.empty()) {
-            for (int b = 0; b < bands_; ++b)
-                emitted_[n] += node.areaM2 * (radiosity_[n][kUpper][b] + radiosity_[n][kLower][b]);
+    // Children before parents: each subtree of the root in parallel (a pre-order range of
+    // its own), then the root.
+    emitted_.resize(hierarchy_.Size(), 0.0);
+    tbb::parallel_for(std::size_t{0}, subtrees_.size(), [&](std::size_t t) {
+        for (std::size_t i = subtrees_[t].second; i-- > subtrees_[t].first;) PullNode(preOrder_[i]);
+    });
+    PullNode(preOrder_.front());
+}
+
+template <int kBands>
+void HrcSolver<kBands>::PullNode(std::uint32_t n) {
+    const HrcNode& node = hierarchy_[n];
+    double& emitted = emitted_[n];
+    emitted = 0.0;
+    if (node.patch && node.children.empty()) {
+        for (int b = 0; b < bands_; ++b) {
+            emitted += node.areaM2 * (radiosity_[n][kUpper][b] + radiosity_[n][kLower][b]);
         }
-        if (node.parent != kNoNode) emitted_[node.parent] += emitted_[n];
-        if (node.patch) {
-            if (node.children.empty()) continue;
-            Sided mean{};  // a split patch radiates the mean of its four parts
-            for (std::uint32_t child : node.children) {
-                for (int s : {kUpper, kLower}) {
-                    for (int b = 0; b < bands_; ++b) mean[s][b] += 0.25 * radiosity_[child][s][b];
-                }
+        return;
+    }
+    for (std::uint32_t child : node.children) emitted += emitted_[child];
+    if (node.patch) {
+        Sided mean{};  // a split patch radiates the mean of its four parts
+        for (std::uint32_t child : node.children) {
+            for (int s : {kUpper, kLower}) {
+                for (int b = 0; b < bands_; ++b) mean[s][b] += 0.25 * radiosity_[child][s][b];
             }
-            radiosity_[n] = mean;
+        }
+        radiosity_[n] = mean;
+        return;
+    }
+    double* out = &intensity_[static_cast<std::size_t>(slot_[n]) * bins_ * bands_];
+    std::fill(out, out + bins_ * bands_, 0.0);
+    for (std::uint32_t child : node.children) {
+        const HrcNode& c = hierarchy_[child];
+        if (!c.patch) {
+            const double* in = &intensity_[static_cast<std::size_t>(slot_[child]) * bins_ * bands_];
+            for (int i = 0; i < bins_ * bands_; ++i) out[i] += in[i];
             continue;
         }
-        double* out = &intensity_[static_cast<std::size_t>(slot_[n]) * bins_ * bands_];
-        std::fill(out, out + bins_ * bands_, 0.0);
-        for (std::uint32_t child : node.children) {
-            const HrcNode& c = hierarchy_[child];
-            if (!c.patch) {
-                const double* in =
-                    &intensity_[static_cast<std::size_t>(slot_[child]) * bins_ * bands_];
-                for (int i = 0; i < bins_ * bands_; ++i) out[i] += in[i];
-                continue;
-            }
-            for (int d = 0; d < bins_; ++d) {
-                const double cosine = glm::dot(c.normal, directions_.Direction(d));
-                const int side = cosine > 0.0 ? kUpper : kLower;
-                const double scale = c.areaM2 * std::abs(cosine) / kPi;
-                for (int b = 0; b < bands_; ++b)
-                    out[d * bands_ + b] += scale * radiosity_[child][side][b];
-            }
+        for (int d = 0; d < bins_; ++d) {
+            const double cosine = glm::dot(c.normal, directions_.Direction(d));
+            const int side = cosine > 0.0 ? kUpper : kLower;
+            const double scale = c.areaM2 * std::abs(cosine) / kPi;
+            for (int b = 0; b < bands_; ++b)
+                out[d * bands_ + b] += scale * radiosity_[child][side][b];
         }
     }
 }
@@ -714,23 +751,33 @@ void HrcSolver<kBands>::PushSubtree(std::uint32_t start, const Level& above, boo
 
 template <int kBands>
 double HrcSolver<kBands>::UpdateRadiosity() {
-    double change = 0.0, largest = 0.0;
-    for (std::uint32_t n : preOrder_) {
-        const HrcNode& node = hierarchy_[n];
-        if (!node.patch || !node.children.empty()) continue;
-        const SideOptics& o = optics_[node.receiver];
-        const Sided& e = irradiance_[n];
-        for (int k = 0; k < bands_; ++k) {
-            const double upper =
-                emission_[n][k] + o.rho[kUpper][k] * e[kUpper][k] + o.tau[kLower][k] * e[kLower][k];
-            const double lower = o.rho[kLower][k] * e[kLower][k] + o.tau[kUpper][k] * e[kUpper][k];
-            change = std::max({change, std::abs(upper - radiosity_[n][kUpper][k]),
-                               std::abs(lower - radiosity_[n][kLower][k])});
-            largest = std::max({largest, upper, lower});
-            radiosity_[n][kUpper][k] = upper;
-            radiosity_[n][kLower][k] = lower;
-        }
-    }
+    // B₁ = E + ρ₁I₁ + τ₂→₁I₂, B₂ = ρ₂I₂ + τ₁→₂I₁ on every leaf patch (Soler 2003 §4.3); the
+    // largest change and value are order-free maxima, so the parallel sweep is exact.
+    using Range = tbb::blocked_range<std::size_t>;
+    const auto [change, largest] = tbb::parallel_reduce(
+        Range(0, leaves_.size()), std::pair<double, double>{0.0, 0.0},
+        [&](const Range& range, std::pair<double, double> acc) {
+            for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                const std::uint32_t n = leaves_[i];
+                const SideOptics& o = optics_[hierarchy_[n].receiver];
+                const Sided& e = irradiance_[n];
+                for (int k = 0; k < bands_; ++k) {
+                    const double upper = emission_[n][k] + o.rho[kUpper][k] * e[kUpper][k] +
+                                         o.tau[kLower][k] * e[kLower][k];
+                    const double lower =
+                        o.rho[kLower][k] * e[kLower][k] + o.tau[kUpper][k] * e[kUpper][k];
+                    acc.first = std::max({acc.first, std::abs(upper - radiosity_[n][kUpper][k]),
+                                          std::abs(lower - radiosity_[n][kLower][k])});
+                    acc.second = std::max({acc.second, upper, lower});
+                    radiosity_[n][kUpper][k] = upper;
+                    radiosity_[n][kLower][k] = lower;
+                }
+            }
+            return acc;
+        },
+        [](std::pair<double, double> a, std::pair<double, double> b) {
+            return std::pair{std::max(a.first, b.first), std::max(a.second, b.second)};
+        });
     return largest > 0.0 ? change / largest : 0.0;
 }
 
@@ -791,6 +838,7 @@ void HrcSolver<kBands>::Outputs(Solution& solution) {
     for (const auto& l : sourceLinks_) links += l.size();
     solution.stats.links = static_cast<std::int64_t>(links);
     solution.stats.elements = static_cast<std::int64_t>(hierarchy_.Size());
+    solution.stats.refinementDepth = static_cast<int>(subtrees_.empty() ? 0 : Depth());
     if (hierarchy_.Root() == kNoNode) return;
     // Escape: the cosine-weighted fraction of each leaf patch's sides that sees out.
     std::vector<std::uint32_t> leaves;

@@ -1,0 +1,43 @@
+#!/usr/bin/env python3
+"""Compares per-leaf results of two solvers: `compare.py REFERENCE.csv OTHER.csv`.
+Prints, per band, the L2 error in % of the reference maximum (Soler 2003, Fig. 14) and the
+mean and 95th-percentile relative errors over lit leaves (5 % of the brightest or more)."""
+import csv
+import math
+import sys
+
+LIT = 0.05
+
+
+def load(path):
+    """Leaf irradiance (both sides, W/m²) by (organ, band)."""
+    values = {}
+    for row in csv.DictReader(open(path)):
+        if row["organ"].startswith("leaf"):
+            values[(row["organ"], row["band"])] = (float(row["irradiance_upper_wm2"]) +
+                                                   float(row["irradiance_lower_wm2"]))
+    return values
+
+
+def errors(reference, value, band):
+    """(L2 % of max, mean relative %, 95th-percentile relative %) over one band's leaves."""
+    keys = [k for k in reference if k[1] == band]
+    largest = max(reference[k] for k in keys)
+    l2 = math.sqrt(sum((value[k] - reference[k]) ** 2 for k in keys) / len(keys)) / largest
+    relative = sorted(abs(value[k] - reference[k]) / reference[k] for k in keys if reference[k] >= LIT * largest)
+    mean = sum(relative) / len(relative)
+    p95 = relative[min(len(relative) - 1, int(0.95 * len(relative)))]
+    return 100 * l2, 100 * mean, 100 * p95
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    reference, value = load(sys.argv[1]), load(sys.argv[2])
+    for band in sorted({k[1] for k in reference}):
+        l2, mean, p95 = errors(reference, value, band)
+        print(f"{band}: L2 {l2:.2f} % of max, mean relative {mean:.2f} %, 95th percentile {p95:.2f} %")
+
+
+if __name__ == "__main__":
+    main()
