@@ -1,5 +1,6 @@
 // leaflux: the one-shot command line. `solve` lights a scene file, `generate` writes a
 // procedural tree or plantation as a scene file.
+#include <google/protobuf/text_format.h>
 #include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
 
@@ -8,8 +9,10 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include "server/scene_proto.h"
+#include "server/transport.h"
 #include "solver/error.h"
 #include "solver/export.h"
 #include "solver/generator.h"
@@ -126,6 +129,67 @@ int RunGenerate(const GenerateCommand& command) {
     return 0;
 }
 
+struct ClientCommand {
+    std::string endpoint = "tcp://127.0.0.1:5555", scene, session, delta, solver = "hrc";
+    std::int64_t number = 1;
+    bool leaves = true, structures = false;
+    double epsilon = 1e-4;
+    int timeoutS = 600;
+};
+
+// Sends one request to leafluxd and prints the reply in protobuf text format.
+int RunClient(const ClientCommand& command, v1::Request request) {
+    request.set_version(v1::PROTOCOL_VERSION_CURRENT);
+    zmq::context_t context;
+    ClientConnection connection(context, command.endpoint);
+    std::string bytes, answer;
+    request.SerializeToString(&bytes);
+    if (!connection.Call(bytes, answer, command.timeoutS * 1000)) {
+        spdlog::error("no reply from {} within {} s", command.endpoint, command.timeoutS);
+        return 4;
+    }
+    v1::Reply reply;
+    if (!reply.ParseFromString(answer)) {
+        spdlog::error("the reply is not a leaflux.v1.Reply");
+        return 4;
+    }
+    std::string text;
+    google::protobuf::TextFormat::PrintToString(reply, &text);
+    std::cout << text;
+    return reply.has_error() ? 2 : 0;
+}
+
+v1::Request OpenFromFile(const ClientCommand& command) {
+    // The scene file's imports are read here: the daemon reads no files.
+    v1::Request request;
+    *request.mutable_open_session()->mutable_scene() = ToProto(LoadSceneFile(command.scene));
+    v1::SolverSettings* settings = request.mutable_open_session()->mutable_settings();
+    settings->set_solver(command.solver == "mc" ? v1::SOLVER_KIND_MONTE_CARLO
+                                                : v1::SOLVER_KIND_HRC);
+    settings->set_epsilon(command.epsilon);
+    return request;
+}
+
+v1::Request CycleFromFile(const ClientCommand& command) {
+    v1::Request request;
+    v1::Cycle* cycle = request.mutable_cycle();
+    cycle->set_session(command.session);
+    cycle->set_number(command.number);
+    cycle->mutable_outputs()->set_leaves(command.leaves);
+    cycle->mutable_outputs()->set_structures(command.structures);
+    if (!command.delta.empty()) {
+        std::ifstream in(command.delta);
+        std::stringstream text;
+        text << in.rdbuf();
+        if (!in ||
+            !google::protobuf::TextFormat::ParseFromString(text.str(), cycle->mutable_delta())) {
+            throw InputError(ErrorCode::kParse, command.delta,
+                             "not a leaflux.v1.TopologyDelta in text format");
+        }
+    }
+    return request;
+}
+
 }  // namespace
 }  // namespace leaflux
 
@@ -215,11 +279,44 @@ int main(int argc, char** argv) {
                           "No internode geometry (leaves only)");
     generateApp->add_option("--out", generate.out, "Scene file to write")->required();
 
+    ClientCommand client;
+    CLI::App* clientApp = app.add_subcommand("client", "Talk to a running leafluxd by hand");
+    clientApp->require_subcommand(1);
+    clientApp->add_option("--endpoint", client.endpoint, "leafluxd's endpoint");
+    clientApp->add_option("--timeout", client.timeoutS, "Seconds to wait for the reply");
+    CLI::App* openApp = clientApp->add_subcommand("open", "Open a session from a scene file");
+    openApp->add_option("--scene", client.scene, "Scene file")
+        ->required()
+        ->check(CLI::ExistingFile);
+    openApp->add_option("--solver", client.solver, "hrc or mc")
+        ->check(CLI::IsMember({"mc", "hrc"}));
+    openApp->add_option("--epsilon", client.epsilon, "hrc: link error bound")
+        ->check(CLI::Range(1e-9, 1.0));
+    CLI::App* cycleApp = clientApp->add_subcommand("cycle", "Send a cycle, with a delta file");
+    cycleApp->add_option("--session", client.session, "Session id")->required();
+    cycleApp->add_option("--number", client.number, "Cycle number");
+    cycleApp->add_option("--delta", client.delta, "leaflux.v1.TopologyDelta in text format")
+        ->check(CLI::ExistingFile);
+    cycleApp->add_flag("!--no-leaves", client.leaves, "No per-organ results");
+    cycleApp->add_flag("--structures", client.structures, "Per-structure results");
+    CLI::App* statusApp = clientApp->add_subcommand("status", "The daemon's or a session's status");
+    statusApp->add_option("--session", client.session, "Session id (default: all)");
+    CLI::App* closeApp = clientApp->add_subcommand("close", "Close a session");
+    closeApp->add_option("--session", client.session, "Session id")->required();
+    CLI::App* shutdownApp = clientApp->add_subcommand("shutdown", "Stop the daemon");
+
     CLI11_PARSE(app, argc, argv);
     spdlog::cfg::load_env_levels();  // SPDLOG_LEVEL=debug shows the solvers' phases
     try {
         if (solveApp->parsed()) return RunSolve(solve);
         if (generateApp->parsed()) return RunGenerate(generate);
+        if (openApp->parsed()) return RunClient(client, OpenFromFile(client));
+        if (cycleApp->parsed()) return RunClient(client, CycleFromFile(client));
+        v1::Request request;
+        if (statusApp->parsed()) request.mutable_status()->set_session(client.session);
+        if (closeApp->parsed()) request.mutable_close_session()->set_session(client.session);
+        if (shutdownApp->parsed()) request.mutable_shutdown();
+        if (clientApp->parsed()) return RunClient(client, request);
     } catch (const InputError& e) {
         spdlog::error("{}", e.what());
         return 2;

@@ -163,41 +163,44 @@ v1::SkyDiscretization DiscretizationToProto(SkyDiscretization d) {
     return v1::SKY_DISCRETIZATION_CONTINUOUS;
 }
 
+}  // namespace
+
+Sun SunFromProto(const Scene& scene, const v1::Sun& in, const std::string& field) {
+    Sun sun;
+    if (in.has_solar()) {
+        const v1::SolarPosition& p = in.solar();
+        if (!std::isfinite(p.latitude_deg()) || std::abs(p.latitude_deg()) > 90.0) {
+            Fail(ErrorCode::kInvalidArgument, field + ".solar.latitude_deg",
+                 "must be in [-90, 90]");
+        }
+        if (p.day_of_year() < 1 || p.day_of_year() > 366) {
+            Fail(ErrorCode::kInvalidArgument, field + ".solar.day_of_year", "must be in [1, 366]");
+        }
+        if (!std::isfinite(p.solar_time_h()) || p.solar_time_h() < 0.0 || p.solar_time_h() > 24.0) {
+            Fail(ErrorCode::kInvalidArgument, field + ".solar.solar_time_h", "must be in [0, 24]");
+        }
+        sun.towardSun =
+            DirectionFromAngles(SolarPosition(p.latitude_deg(), p.day_of_year(), p.solar_time_h()));
+    } else {
+        const glm::dvec3 d(in.direction().x(), in.direction().y(), in.direction().z());
+        const double length = glm::length(d);
+        if (!std::isfinite(length) || length == 0.0) {
+            Fail(ErrorCode::kInvalidArgument, field + ".direction",
+                 "must be a finite non-zero vector");
+        }
+        sun.towardSun = d / length;
+    }
+    sun.normalIrradianceWm2 = PerBand(scene, in.normal_irradiance(), field + ".normal_irradiance");
+    sun.angularRadiusRad = glm::radians(in.angular_radius_deg());
+    return sun;
+}
+
+namespace {
+
 void ReadSources(const v1::Scene& message, Scene& scene, const std::filesystem::path& base) {
     for (int i = 0; i < message.suns_size(); ++i) {
-        const v1::Sun& in = message.suns(i);
-        const std::string field = "suns[" + std::to_string(i) + "]";
-        Sun sun;
-        if (in.has_solar()) {
-            const v1::SolarPosition& p = in.solar();
-            if (!std::isfinite(p.latitude_deg()) || std::abs(p.latitude_deg()) > 90.0) {
-                Fail(ErrorCode::kInvalidArgument, field + ".solar.latitude_deg",
-                     "must be in [-90, 90]");
-            }
-            if (p.day_of_year() < 1 || p.day_of_year() > 366) {
-                Fail(ErrorCode::kInvalidArgument, field + ".solar.day_of_year",
-                     "must be in [1, 366]");
-            }
-            if (!std::isfinite(p.solar_time_h()) || p.solar_time_h() < 0.0 ||
-                p.solar_time_h() > 24.0) {
-                Fail(ErrorCode::kInvalidArgument, field + ".solar.solar_time_h",
-                     "must be in [0, 24]");
-            }
-            sun.towardSun = DirectionFromAngles(
-                SolarPosition(p.latitude_deg(), p.day_of_year(), p.solar_time_h()));
-        } else {
-            const glm::dvec3 d(in.direction().x(), in.direction().y(), in.direction().z());
-            const double length = glm::length(d);
-            if (!std::isfinite(length) || length == 0.0) {
-                Fail(ErrorCode::kInvalidArgument, field + ".direction",
-                     "must be a finite non-zero vector");
-            }
-            sun.towardSun = d / length;
-        }
-        sun.normalIrradianceWm2 =
-            PerBand(scene, in.normal_irradiance(), field + ".normal_irradiance");
-        sun.angularRadiusRad = glm::radians(in.angular_radius_deg());
-        scene.sources.suns.push_back(std::move(sun));
+        scene.sources.suns.push_back(
+            SunFromProto(scene, message.suns(i), "suns[" + std::to_string(i) + "]"));
     }
     for (int i = 0; i < message.sun_periods_size(); ++i) {
         const v1::SunPeriod& p = message.sun_periods(i);
@@ -252,6 +255,41 @@ void ReadSources(const v1::Scene& message, Scene& scene, const std::filesystem::
 
 }  // namespace
 
+Node NodeFromProto(const v1::Node& in, const MeshLibrary& meshes) {
+    Node node;
+    node.id = in.id();
+    node.parent = in.parent();
+    node.type = TypeFromProto(in.type());
+    node.name = in.name();
+    node.parentFromLocal = FrameFromProto(in.frame(), "frame", in.id());
+    node.age = in.age();
+    node.attributes.insert(in.attributes().begin(), in.attributes().end());
+    if (in.has_organ()) {
+        const v1::Organ& organ = in.organ();
+        std::shared_ptr<const Mesh> mesh;
+        if (organ.has_mesh_ref()) {
+            const auto it = meshes.find(organ.mesh_ref());
+            if (it == meshes.end()) {
+                Fail(ErrorCode::kNotFound, "organ.mesh_ref",
+                     "names no mesh '" + organ.mesh_ref() + "'", in.id());
+            }
+            mesh = it->second;
+        } else {
+            mesh = MeshFromProto(organ.mesh(), "organ.mesh", in.id());
+        }
+        node.organ = Organ{mesh, organ.optics()};
+    }
+    return node;
+}
+
+MeshLibrary MeshesFromProto(const v1::Scene& message) {
+    MeshLibrary meshes;
+    for (const auto& [name, mesh] : message.meshes()) {
+        meshes[name] = MeshFromProto(mesh, "meshes[" + name + "]");
+    }
+    return meshes;
+}
+
 // Imports are in scene_import.cpp.
 void ReadImports(const v1::Scene& message, Scene& scene, const std::filesystem::path& base);
 
@@ -286,34 +324,8 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory) {
         }
         scene.optics.push_back(std::move(o));
     }
-    std::map<std::string, std::shared_ptr<const Mesh>> meshes;
-    for (const auto& [name, mesh] : message.meshes())
-        meshes[name] = MeshFromProto(mesh, "meshes[" + name + "]");
-    for (const v1::Node& in : message.nodes()) {
-        Node node;
-        node.id = in.id();
-        node.parent = in.parent();
-        node.type = TypeFromProto(in.type());
-        node.name = in.name();
-        node.parentFromLocal = FrameFromProto(in.frame(), "frame", in.id());
-        node.age = in.age();
-        node.attributes.insert(in.attributes().begin(), in.attributes().end());
-        if (in.has_organ()) {
-            const v1::Organ& organ = in.organ();
-            std::shared_ptr<const Mesh> mesh;
-            if (organ.has_mesh_ref()) {
-                const auto it = meshes.find(organ.mesh_ref());
-                if (it == meshes.end())
-                    Fail(ErrorCode::kNotFound, "organ.mesh_ref",
-                         "names no mesh '" + organ.mesh_ref() + "'", in.id());
-                mesh = it->second;
-            } else {
-                mesh = MeshFromProto(organ.mesh(), "organ.mesh", in.id());
-            }
-            node.organ = Organ{mesh, organ.optics()};
-        }
-        scene.nodes.push_back(std::move(node));
-    }
+    const MeshLibrary meshes = MeshesFromProto(message);
+    for (const v1::Node& in : message.nodes()) scene.nodes.push_back(NodeFromProto(in, meshes));
     for (const v1::Surface& surface : message.environment()) {
         scene.environment.push_back(
             {surface.name(),

@@ -5,12 +5,24 @@
 // Scene::Validate: a Scene it returns is valid. Errors are InputError naming the field.
 #pragma once
 
+#include <map>
+#include <memory>
 #include <string>
 
 #include "leaflux.pb.h"
 #include "solver/scene.h"
 
 namespace leaflux {
+
+// Shared meshes by name (Scene.meshes), which later organs may reference.
+using MeshLibrary = std::map<std::string, std::shared_ptr<const Mesh>>;
+MeshLibrary MeshesFromProto(const v1::Scene& message);
+
+// One node; its mesh_ref resolved in `meshes`. Not validated: Scene::Validate does that.
+Node NodeFromProto(const v1::Node& node, const MeshLibrary& meshes);
+
+// A sun for `scene`'s bands; `field` names it in errors.
+Sun SunFromProto(const Scene& scene, const v1::Sun& sun, const std::string& field);
 
 // `baseDirectory` resolves relative import paths (the scene file's folder).
 Scene FromProto(const v1::Scene& message, const std::string& baseDirectory);

@@ -1,0 +1,356 @@
+#include "server/daemon.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <set>
+#include <unordered_map>
+
+#include "solver/error.h"
+
+namespace leaflux {
+namespace {
+
+v1::ErrorCode ToProto(ErrorCode code) {
+    switch (code) {
+        case ErrorCode::kInvalidArgument:
+            return v1::ERROR_CODE_INVALID_ARGUMENT;
+        case ErrorCode::kNotFound:
+            return v1::ERROR_CODE_NOT_FOUND;
+        case ErrorCode::kAlreadyExists:
+            return v1::ERROR_CODE_ALREADY_EXISTS;
+        case ErrorCode::kDegenerate:
+            return v1::ERROR_CODE_DEGENERATE;
+        case ErrorCode::kCycle:
+            return v1::ERROR_CODE_CYCLE;
+        case ErrorCode::kParse:
+            return v1::ERROR_CODE_PARSE;
+        case ErrorCode::kIo:
+            return v1::ERROR_CODE_IO;
+        case ErrorCode::kUnsupported:
+            return v1::ERROR_CODE_UNSUPPORTED;
+    }
+    return v1::ERROR_CODE_INTERNAL;
+}
+
+// A session-level unknown id: its own code, so a client knows to resync.
+class UnknownSession : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+SolverSettings SettingsFromProto(const v1::SolverSettings& in) {
+    SolverSettings settings;
+    settings.kind =
+        in.solver() == v1::SOLVER_KIND_MONTE_CARLO ? SolverKind::kMonteCarlo : SolverKind::kHrc;
+    if (in.epsilon() != 0.0) {
+        if (!(in.epsilon() > 0.0 && in.epsilon() < 1.0)) {
+            throw InputError(ErrorCode::kInvalidArgument, "settings.epsilon", "must be in (0, 1)");
+        }
+        settings.hrc.epsilon = in.epsilon();
+    }
+    if (in.samples() < 0 || in.samples() > (1 << 24)) {
+        throw InputError(ErrorCode::kInvalidArgument, "settings.samples", "must be in [0, 2^24]");
+    }
+    if (in.samples() > 0) settings.monteCarlo.samplesPerReceiver = in.samples();
+    if (in.threads() < 0 || in.threads() > 1024) {
+        throw InputError(ErrorCode::kInvalidArgument, "settings.threads", "must be in [0, 1024]");
+    }
+    if (in.subdivision() < 0 || in.subdivision() > 8) {
+        throw InputError(ErrorCode::kInvalidArgument, "settings.subdivision", "must be in [0, 8]");
+    }
+    if (in.subdivision() > 0) settings.hrc.maxSubdivision = in.subdivision();
+    settings.monteCarlo.seed = in.seed() == 0 ? 1 : in.seed();
+    settings.monteCarlo.threads = settings.hrc.threads = in.threads();
+    return settings;
+}
+
+void BandsToProto(const Scene& scene, const std::vector<BandLight>& bands,
+                  const std::vector<int>& wanted,
+                  google::protobuf::RepeatedPtrField<v1::BandLight>* out) {
+    for (int b : wanted) {
+        const BandLight& light = bands[b];
+        v1::BandLight* band = out->Add();
+        band->set_band(scene.bands[b].name);
+        band->set_irradiance_upper_wm2(light.irradianceUpperWm2);
+        band->set_irradiance_lower_wm2(light.irradianceLowerWm2);
+        band->set_absorbed_w(light.absorbedW);
+        const glm::dvec3 v = light.LightVector();
+        band->mutable_light_vector()->set_x(v.x);
+        band->mutable_light_vector()->set_y(v.y);
+        band->mutable_light_vector()->set_z(v.z);
+        band->set_stderr_upper_wm2(light.stderrUpperWm2);
+        band->set_stderr_lower_wm2(light.stderrLowerWm2);
+    }
+}
+
+}  // namespace
+
+v1::Reply ErrorReply(v1::ErrorCode code, const std::string& message, const std::string& field,
+                     std::uint64_t node) {
+    v1::Reply reply;
+    reply.set_version(v1::PROTOCOL_VERSION_CURRENT);
+    v1::Error* error = reply.mutable_error();
+    error->set_code(code);
+    error->set_message(message);
+    error->set_field(field);
+    error->set_node(node);
+    return reply;
+}
+
+Session::Session(Scene scene, MeshLibrary meshes, SolverSettings settings)
+    : scene_(std::move(scene)), meshes_(std::move(meshes)), settings_(std::move(settings)) {}
+
+v1::CycleResult Session::Run(const v1::Cycle& cycle) {
+    Scene next = Next(cycle);
+    v1::CycleResult result = Solve(next, cycle.outputs());
+    scene_ = std::move(next);
+    ++cycles_;
+    return result;
+}
+
+Scene Session::Next(const v1::Cycle& cycle) const {
+    Scene next = scene_;
+    const v1::TopologyDelta& delta = cycle.delta();
+    std::unordered_map<NodeId, std::size_t> at;
+    for (std::size_t i = 0; i < next.nodes.size(); ++i) at[next.nodes[i].id] = i;
+    // Removals take their whole subtree.
+    std::set<NodeId> removed;
+    for (std::uint64_t id : delta.removed()) {
+        if (!at.count(id))
+            throw InputError(ErrorCode::kNotFound, "delta.removed", "no such node", id);
+        removed.insert(id);
+    }
+    for (bool grew = true; grew;) {
+        grew = false;
+        for (const Node& node : next.nodes) {
+            if (node.parent != kNoParent && removed.count(node.parent) &&
+                removed.insert(node.id).second)
+                grew = true;
+        }
+    }
+    for (const v1::Node& in : delta.updated()) {
+        const auto it = at.find(in.id());
+        if (it == at.end() || removed.count(in.id())) {
+            throw InputError(ErrorCode::kNotFound, "delta.updated", "no such node to update",
+                             in.id());
+        }
+        next.nodes[it->second] = NodeFromProto(in, meshes_);
+    }
+    std::erase_if(next.nodes, [&](const Node& node) { return removed.count(node.id) > 0; });
+    for (const v1::Node& in : delta.added()) {
+        if (at.count(in.id()) && !removed.count(in.id())) {
+            throw InputError(ErrorCode::kAlreadyExists, "delta.added", "a node with this id exists",
+                             in.id());
+        }
+        next.nodes.push_back(NodeFromProto(in, meshes_));
+    }
+    if (cycle.suns_size() > 0) {
+        next.sources.suns.clear();
+        for (int i = 0; i < cycle.suns_size(); ++i) {
+            next.sources.suns.push_back(
+                SunFromProto(next, cycle.suns(i), "suns[" + std::to_string(i) + "]"));
+        }
+    }
+    next.Validate();  // whole, before anything is kept
+    return next;
+}
+
+void Session::Replace(Scene scene, MeshLibrary meshes) {
+    scene_ = std::move(scene);
+    meshes_ = std::move(meshes);
+}
+
+v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outputs) const {
+    std::vector<int> wanted;
+    for (const std::string& band : outputs.bands()) {
+        const int b = scene.BandIndex(band);
+        if (b < 0)
+            throw InputError(ErrorCode::kNotFound, "outputs.bands[" + band + "]",
+                             "names no declared band");
+        wanted.push_back(b);
+    }
+    if (wanted.empty()) {
+        for (std::size_t b = 0; b < scene.bands.size(); ++b) wanted.push_back(static_cast<int>(b));
+    }
+    const PreparedScene prepared(scene);
+    const Solution solution = leaflux::Solve(prepared, settings_);
+    v1::CycleResult result;
+    if (outputs.leaves()) {
+        for (std::size_t r = 0; r < prepared.Flat().receivers.size(); ++r) {
+            const Receiver& receiver = prepared.Flat().receivers[r];
+            v1::OrganLight* organ = result.add_organs();
+            organ->set_node(receiver.node);
+            organ->set_name(receiver.name);
+            organ->set_area_m2(receiver.areaM2);
+            BandsToProto(scene, solution.light[r], wanted, organ->mutable_bands());
+        }
+    }
+    if (outputs.structures()) {
+        for (const StructureLight& s : AggregateStructures(scene, prepared.Flat(), solution)) {
+            v1::StructureLight* structure = result.add_structures();
+            structure->set_node(s.node);
+            structure->set_name(s.name);
+            structure->set_organs(s.organCount);
+            structure->set_area_m2(s.areaM2);
+            BandsToProto(scene, s.bands, wanted, structure->mutable_bands());
+        }
+    }
+    v1::SolveStatistics* stats = result.mutable_statistics();
+    stats->set_wall_seconds(solution.stats.wallSeconds);
+    stats->set_cpu_seconds(solution.stats.cpuSeconds);
+    stats->set_peak_rss_bytes(solution.stats.peakRssBytes);
+    stats->set_rays(solution.stats.rays);
+    stats->set_links(solution.stats.links);
+    stats->set_elements(solution.stats.elements);
+    stats->set_iterations(solution.stats.iterations);
+    stats->set_residual(solution.stats.residual);
+    for (int b : wanted) {
+        v1::EnergyBalance* balance = stats->add_balance();
+        balance->set_band(scene.bands[b].name);
+        balance->set_incident_w(solution.balance[b].incidentW);
+        balance->set_absorbed_w(solution.balance[b].absorbedW);
+        balance->set_escaped_w(solution.balance[b].escapedW);
+    }
+    return result;
+}
+
+Daemon::Daemon(DaemonLimits limits) : limits_(limits) {}
+
+std::string Daemon::Handle(const std::string& bytes) {
+    v1::Request request;
+    v1::Reply reply;
+    if (!request.ParseFromString(bytes)) {
+        reply = ErrorReply(v1::ERROR_CODE_PARSE, "the message is not a leaflux.v1.Request");
+    } else {
+        reply = Handle(request);
+    }
+    std::string out;
+    reply.SerializeToString(&out);
+    return out;
+}
+
+v1::Reply Daemon::Handle(const v1::Request& request) {
+    std::lock_guard lock(mutex_);
+    ++requests_;
+    v1::Reply reply;
+    try {  // the one place a request's failure is caught
+        if (request.version() > v1::PROTOCOL_VERSION_CURRENT) {
+            throw InputError(ErrorCode::kUnsupported, "version",
+                             "is newer than this daemon understands");
+        }
+        switch (request.body_case()) {
+            case v1::Request::kOpenSession:
+                reply = Open(request.open_session());
+                break;
+            case v1::Request::kCycle:
+                reply = RunCycle(request.cycle());
+                break;
+            case v1::Request::kResync:
+                reply = Resynchronise(request.resync());
+                break;
+            case v1::Request::kStatus:
+                reply = Status(request.status());
+                break;
+            case v1::Request::kCloseSession:
+                reply = Close(request.close_session());
+                break;
+            case v1::Request::kShutdown:
+                shutdown_ = true;
+                reply.mutable_done();
+                break;
+            default:
+                reply =
+                    ErrorReply(v1::ERROR_CODE_UNSUPPORTED, "the request has no known body", "body");
+        }
+    } catch (const InputError& e) {
+        reply = ErrorReply(ToProto(e.Code()), e.what(), e.Field(), e.Node().value_or(0));
+    } catch (const UnknownSession& e) {
+        reply = ErrorReply(v1::ERROR_CODE_UNKNOWN_SESSION, e.what(), "session");
+    } catch (const std::exception& e) {
+        spdlog::error("request {}: internal error: {}", request.request_id(), e.what());
+        reply = ErrorReply(v1::ERROR_CODE_INTERNAL, e.what());
+    }
+    reply.set_version(v1::PROTOCOL_VERSION_CURRENT);
+    reply.set_request_id(request.request_id());
+    return reply;
+}
+
+Session& Daemon::Find(const std::string& id) {
+    const auto it = sessions_.find(id);
+    if (it == sessions_.end())
+        throw UnknownSession("unknown session '" + id + "': open or resync it");
+    return *it->second;
+}
+
+v1::Reply Daemon::Open(const v1::OpenSession& request) {
+    if (sessions_.size() >= limits_.maxSessions) {
+        throw InputError(
+            ErrorCode::kInvalidArgument, "open_session",
+            "the daemon serves at most " + std::to_string(limits_.maxSessions) + " sessions");
+    }
+    if (request.scene().imports_size() > 0 || request.scene().can_lights_size() > 0) {
+        throw InputError(ErrorCode::kUnsupported, "scene.imports",
+                         "the daemon reads no files: send the geometry");
+    }
+    Scene scene = FromProto(request.scene(), "");
+    SolverSettings settings = SettingsFromProto(request.settings());
+    const std::string id = "s" + std::to_string(nextSession_++);
+    sessions_[id] = std::make_unique<Session>(std::move(scene), MeshesFromProto(request.scene()),
+                                              std::move(settings));
+    spdlog::info("session {} opened", id);
+    v1::Reply reply;
+    reply.mutable_opened()->set_session(id);
+    return reply;
+}
+
+v1::Reply Daemon::RunCycle(const v1::Cycle& request) {
+    Session& session = Find(request.session());
+    v1::Reply reply;
+    *reply.mutable_cycle() = session.Run(request);
+    reply.mutable_cycle()->set_session(request.session());
+    reply.mutable_cycle()->set_number(request.number());
+    return reply;
+}
+
+v1::Reply Daemon::Resynchronise(const v1::Resync& request) {
+    if (request.session().empty())
+        throw InputError(ErrorCode::kInvalidArgument, "session", "is empty");
+    Scene scene = FromProto(request.scene(), "");
+    auto it = sessions_.find(request.session());
+    if (it == sessions_.end()) {
+        throw UnknownSession("unknown session '" + request.session() + "': open a new one");
+    }
+    it->second->Replace(std::move(scene), MeshesFromProto(request.scene()));
+    v1::Reply reply;
+    reply.mutable_done();
+    return reply;
+}
+
+v1::Reply Daemon::Status(const v1::StatusRequest& request) {
+    v1::Reply reply;
+    v1::StatusReply* status = reply.mutable_status();
+    status->set_requests(requests_);
+    for (const auto& [id, session] : sessions_) {
+        if (!request.session().empty() && id != request.session()) continue;
+        v1::SessionStatus* s = status->add_sessions();
+        s->set_session(id);
+        s->set_cycles(session->Cycles());
+        s->set_nodes(static_cast<int>(session->Current().nodes.size()));
+        s->set_organs(static_cast<int>(
+            std::count_if(session->Current().nodes.begin(), session->Current().nodes.end(),
+                          [](const Node& n) { return n.organ.has_value(); })));
+    }
+    if (!request.session().empty() && status->sessions_size() == 0) Find(request.session());
+    return reply;
+}
+
+v1::Reply Daemon::Close(const v1::CloseSession& request) {
+    Find(request.session());
+    sessions_.erase(request.session());
+    v1::Reply reply;
+    reply.mutable_done();
+    return reply;
+}
+
+}  // namespace leaflux

@@ -1,0 +1,61 @@
+// leafluxd: the lighting daemon. Growth models connect over ZeroMQ and speak leaflux.v1
+// (proto/leaflux.proto): OpenSession, then a Cycle per growth step, and CloseSession.
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <csignal>
+
+#include "server/daemon.h"
+#include "server/transport.h"
+
+namespace {
+std::atomic<bool> stopRequested{false};
+void OnSignal(int) { stopRequested = true; }
+}  // namespace
+
+int main(int argc, char** argv) {
+    using namespace leaflux;
+    CLI::App app{"leafluxd: the leaflux lighting daemon (ZeroMQ + protobuf, leaflux.v1)"};
+    std::string bind = "tcp://127.0.0.1:5555", level = "info";
+    DaemonLimits limits;
+    TransportLimits transport;
+    std::size_t maxMegabytes = 256;
+    app.add_option("--bind", bind, "ZeroMQ endpoint to serve (loopback by default)");
+    app.add_option("--log-level", level, "trace, debug, info, warn, error")
+        ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+    app.add_option("--max-sessions", limits.maxSessions, "Sessions served at once")
+        ->check(CLI::Range(1, 100000));
+    app.add_option("--max-message-mb", maxMegabytes, "Largest request accepted (MiB)")
+        ->check(CLI::Range(1, 4096));
+    CLI11_PARSE(app, argc, argv);
+    spdlog::set_level(spdlog::level::from_str(level));
+    transport.maxBytes = maxMegabytes << 20;
+    if (bind.rfind("tcp://127.", 0) != 0 && bind.rfind("tcp://localhost", 0) != 0 &&
+        bind.rfind("ipc://", 0) != 0 && bind.rfind("inproc://", 0) != 0) {
+        spdlog::error("{}: leafluxd binds to loopback only until CurveZMQ keys are supported",
+                      bind);
+        return 2;
+    }
+    std::signal(SIGINT, OnSignal);
+    std::signal(SIGTERM, OnSignal);
+    try {
+        zmq::context_t context;
+        Daemon daemon(limits);
+        RouterServer server(context, bind, transport);
+        spdlog::info("leafluxd serving {}", server.Endpoint());
+        server.Serve([&](const std::string& request) { return daemon.Handle(request); },
+                     [] {
+                         std::string out;
+                         ErrorReply(v1::ERROR_CODE_TOO_LARGE,
+                                    "the message exceeds the daemon's limits")
+                             .SerializeToString(&out);
+                         return out;
+                     },
+                     [&] { return daemon.ShutdownRequested(); }, stopRequested);
+        spdlog::info("leafluxd stopped");
+    } catch (const std::exception& e) {
+        spdlog::error("leafluxd: {}", e.what());
+        return 1;
+    }
+    return 0;
+}

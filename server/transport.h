@@ -1,0 +1,49 @@
+// ZeroMQ transport of leafluxd: a ROUTER socket that reads whole multipart messages (with
+// a cap on frames and bytes), hands the last frame to a handler and sends the reply back
+// with the same envelope. It knows nothing of protobuf or of the solver.
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <string>
+#include <zmq.hpp>
+#include <zmq_addon.hpp>
+
+namespace leaflux {
+
+struct TransportLimits {
+    std::size_t maxFrames = 8;          // routing frames + delimiter + payload
+    std::size_t maxBytes = 256u << 20;  // a message larger than this is refused
+};
+
+class RouterServer {
+  public:
+    // Binds `endpoint` (e.g. tcp://127.0.0.1:5555, tcp://127.0.0.1:* for any port).
+    RouterServer(zmq::context_t& context, const std::string& endpoint, TransportLimits limits = {});
+
+    // The endpoint actually bound (with the port chosen for a "*").
+    std::string Endpoint() const;
+
+    // Serves until `stop` is set (checked every 100 ms) or `handle` asks to stop.
+    // `tooLarge` makes the reply to a message over the limits.
+    void Serve(const std::function<std::string(const std::string&)>& handle,
+               const std::function<std::string()>& tooLarge,
+               const std::function<bool()>& stopAfterReply, const std::atomic<bool>& stop);
+
+  private:
+    zmq::socket_t socket_;
+    TransportLimits limits_;
+};
+
+// A client connection: one request, one reply, with a timeout.
+class ClientConnection {
+  public:
+    ClientConnection(zmq::context_t& context, const std::string& endpoint);
+    // Sends `request`; false when no reply came within `timeoutMs`.
+    bool Call(const std::string& request, std::string& reply, int timeoutMs = 600000);
+
+  private:
+    zmq::socket_t socket_;
+};
+
+}  // namespace leaflux

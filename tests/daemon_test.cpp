@@ -1,0 +1,274 @@
+// leafluxd on loopback: a session over several cycles, and bad requests that each get a
+// typed error while the daemon stays up and the session stays as it was.
+#include "server/daemon.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <thread>
+
+#include "server/transport.h"
+
+namespace leaflux {
+namespace {
+
+class DaemonOnLoopback : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        TransportLimits limits;
+        limits.maxBytes = 1 << 20;  // small, so that an oversized message is cheap to send
+        server_ = std::make_unique<RouterServer>(context_, "tcp://127.0.0.1:*", limits);
+        thread_ = std::thread([this] {
+            server_->Serve(
+                [this](const std::string& r) { return daemon_.Handle(r); },
+                [] {
+                    std::string out;
+                    ErrorReply(v1::ERROR_CODE_TOO_LARGE, "too large").SerializeToString(&out);
+                    return out;
+                },
+                [this] { return daemon_.ShutdownRequested(); }, stop_);
+        });
+        client_ = std::make_unique<ClientConnection>(context_, server_->Endpoint());
+    }
+    void TearDown() override {
+        stop_ = true;
+        thread_.join();
+    }
+
+    v1::Reply Call(const v1::Request& request) {
+        std::string bytes, reply;
+        request.SerializeToString(&bytes);
+        EXPECT_TRUE(client_->Call(bytes, reply, 60000));
+        v1::Reply decoded;
+        EXPECT_TRUE(decoded.ParseFromString(reply));
+        return decoded;
+    }
+
+    zmq::context_t context_;
+    Daemon daemon_;
+    std::unique_ptr<RouterServer> server_;
+    std::unique_ptr<ClientConnection> client_;
+    std::atomic<bool> stop_{false};
+    std::thread thread_;
+};
+
+v1::Node Leaf(std::uint64_t id, std::uint64_t parent, double x, double z = 1.0) {
+    v1::Node node;
+    node.set_id(id);
+    node.set_parent(parent);
+    node.set_type(v1::NODE_TYPE_LEAF);
+    node.set_name("leaf" + std::to_string(id));
+    v1::Organ* organ = node.mutable_organ();
+    organ->set_optics("leaf");
+    for (double v : {x, 0.0, z, x + 0.1, 0.0, z, x + 0.1, 0.1, z, x, 0.1, z})
+        organ->mutable_mesh()->add_positions(v);
+    for (unsigned i : {0u, 1u, 2u, 0u, 2u, 3u}) organ->mutable_mesh()->add_triangles(i);
+    return node;
+}
+
+v1::Request OpenRequest() {
+    v1::Request request;
+    v1::OpenSession* open = request.mutable_open_session();
+    v1::Scene* scene = open->mutable_scene();
+    scene->add_bands()->set_name("PAR");
+    v1::Optics* optics = scene->add_optics();
+    optics->set_id("leaf");
+    v1::BandOptics& par = (*optics->mutable_bands())["PAR"];
+    par.set_rho_upper(0.1), par.set_rho_lower(0.1), par.set_tau_upper(0.05),
+        par.set_tau_lower(0.05);
+    v1::Node* plant = scene->add_nodes();
+    plant->set_id(1);
+    plant->set_type(v1::NODE_TYPE_PLANT);
+    *scene->add_nodes() = Leaf(2, 1, 0.0);
+    v1::Sun* sun = scene->add_suns();
+    sun->mutable_direction()->set_z(1.0);
+    (*sun->mutable_normal_irradiance())["PAR"] = 1000.0;
+    open->mutable_settings()->set_solver(v1::SOLVER_KIND_HRC);
+    return request;
+}
+
+v1::Request CycleRequest(const std::string& session, std::int64_t number) {
+    v1::Request request;
+    request.set_request_id(static_cast<std::uint64_t>(number) + 100);
+    v1::Cycle* cycle = request.mutable_cycle();
+    cycle->set_session(session);
+    cycle->set_number(number);
+    cycle->mutable_outputs()->set_leaves(true);
+    cycle->mutable_outputs()->set_structures(true);
+    return request;
+}
+
+TEST_F(DaemonOnLoopback, SessionLivesOverCyclesOfAddsUpdatesAndRemovals) {
+    const v1::Reply opened = Call(OpenRequest());
+    ASSERT_TRUE(opened.has_opened()) << opened.DebugString();
+    const std::string session = opened.opened().session();
+
+    v1::Reply first = Call(CycleRequest(session, 1));
+    ASSERT_TRUE(first.has_cycle()) << first.DebugString();
+    EXPECT_EQ(first.request_id(), 101u);
+    ASSERT_EQ(first.cycle().organs_size(), 1);
+    // One leaf in the open under a vertical sun: 1000 W/m² on top.
+    EXPECT_NEAR(first.cycle().organs(0).bands(0).irradiance_upper_wm2(), 1000.0, 1e-9);
+
+    v1::Request grow = CycleRequest(session, 2);
+    *grow.mutable_cycle()->mutable_delta()->add_added() = Leaf(3, 1, 0.02, 0.9);  // under leaf 2
+    const v1::Reply second = Call(grow);
+    ASSERT_TRUE(second.has_cycle()) << second.DebugString();
+    ASSERT_EQ(second.cycle().organs_size(), 2);
+    EXPECT_LT(second.cycle().organs(1).bands(0).irradiance_upper_wm2(), 500.0);  // mostly shaded
+    EXPECT_GE(second.cycle().structures_size(), 1);
+
+    v1::Request move = CycleRequest(session, 3);
+    *move.mutable_cycle()->mutable_delta()->add_updated() =
+        Leaf(3, 1, 1.0, 0.9);  // out of the shade
+    const v1::Reply third = Call(move);
+    ASSERT_TRUE(third.has_cycle()) << third.DebugString();
+    // The sun's 1000 W/m², and a few mW/m² from the other leaf's underside a metre away.
+    EXPECT_NEAR(third.cycle().organs(1).bands(0).irradiance_upper_wm2(), 1000.0, 0.01);
+
+    v1::Request prune = CycleRequest(session, 4);
+    prune.mutable_cycle()->mutable_delta()->add_removed(3);
+    const v1::Reply fourth = Call(prune);
+    ASSERT_TRUE(fourth.has_cycle()) << fourth.DebugString();
+    EXPECT_EQ(fourth.cycle().organs_size(), 1);
+    v1::Request status;
+    status.mutable_status()->set_session(session);
+    const v1::Reply state = Call(status);
+    ASSERT_EQ(state.status().sessions_size(), 1);
+    EXPECT_EQ(state.status().sessions(0).nodes(), 2);
+    EXPECT_EQ(state.status().sessions(0).cycles(), 4);
+}
+
+struct BadRequest {
+    const char* what;
+    std::function<v1::Request(const std::string& session)> make;
+    v1::ErrorCode code;
+    std::string field;
+    std::uint64_t node;
+};
+
+TEST_F(DaemonOnLoopback, AnswersEveryBadRequestWithATypedErrorAndChangesNothing) {
+    const std::string session = Call(OpenRequest()).opened().session();
+    ASSERT_FALSE(session.empty());
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const std::vector<BadRequest> cases = {
+        {"unknown session", [](const std::string&) { return CycleRequest("nope", 1); },
+         v1::ERROR_CODE_UNKNOWN_SESSION, "session", 0},
+        {"duplicate id",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             *r.mutable_cycle()->mutable_delta()->add_added() = Leaf(2, 1, 3.0);
+             return r;
+         },
+         v1::ERROR_CODE_ALREADY_EXISTS, "delta.added", 2},
+        {"removal of what does not exist",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             r.mutable_cycle()->mutable_delta()->add_removed(77);
+             return r;
+         },
+         v1::ERROR_CODE_NOT_FOUND, "delta.removed", 77},
+        {"update of what does not exist",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             *r.mutable_cycle()->mutable_delta()->add_updated() = Leaf(78, 1, 0.0);
+             return r;
+         },
+         v1::ERROR_CODE_NOT_FOUND, "delta.updated", 78},
+        {"unknown parent",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             *r.mutable_cycle()->mutable_delta()->add_added() = Leaf(5, 99, 0.0);
+             return r;
+         },
+         v1::ERROR_CODE_NOT_FOUND, "parent", 5},
+        {"a cycle of parents",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Node plant;
+             plant.set_id(1);
+             plant.set_parent(2);
+             *r.mutable_cycle()->mutable_delta()->add_updated() = plant;
+             return r;
+         },
+         v1::ERROR_CODE_CYCLE, "parent", 0},
+        {"NaN vertex",
+         [nan](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Node leaf = Leaf(6, 1, 0.0);
+             leaf.mutable_organ()->mutable_mesh()->set_positions(4, nan);
+             *r.mutable_cycle()->mutable_delta()->add_added() = leaf;
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "organ.mesh.positions", 6},
+        {"degenerate leaf",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Node leaf = Leaf(7, 1, 0.0);
+             for (int i = 0; i < 12; ++i)
+                 leaf.mutable_organ()->mutable_mesh()->set_positions(i, 0.5);
+             *r.mutable_cycle()->mutable_delta()->add_added() = leaf;
+             return r;
+         },
+         v1::ERROR_CODE_DEGENERATE, "organ.mesh.triangles", 7},
+        {"unknown band in outputs",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             r.mutable_cycle()->mutable_outputs()->add_bands("UV");
+             return r;
+         },
+         v1::ERROR_CODE_NOT_FOUND, "outputs.bands[UV]", 0},
+        {"rho + tau > 1 at opening",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             (*r.mutable_open_session()->mutable_scene()->mutable_optics(0)->mutable_bands())["PAR"]
+                 .set_tau_upper(0.95);
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "optics[leaf].bands[PAR]", 0},
+        {"no body", [](const std::string&) { return v1::Request(); }, v1::ERROR_CODE_UNSUPPORTED,
+         "body", 0},
+        {"newer protocol",
+         [](const std::string&) {
+             v1::Request r;
+             r.set_version(static_cast<v1::ProtocolVersion>(9));
+             r.mutable_status();
+             return r;
+         },
+         v1::ERROR_CODE_UNSUPPORTED, "version", 0},
+    };
+    for (const BadRequest& bad : cases) {
+        SCOPED_TRACE(bad.what);
+        const v1::Reply reply = Call(bad.make(session));
+        ASSERT_TRUE(reply.has_error()) << reply.DebugString();
+        EXPECT_EQ(reply.error().code(), bad.code) << reply.error().DebugString();
+        EXPECT_NE(reply.error().field().find(bad.field), std::string::npos)
+            << reply.error().DebugString();
+        if (bad.node != 0) EXPECT_EQ(reply.error().node(), bad.node);
+        // The session is exactly as it was: two nodes, no cycle applied.
+        v1::Request status;
+        status.mutable_status()->set_session(session);
+        const v1::Reply state = Call(status);
+        ASSERT_EQ(state.status().sessions_size(), 1);
+        EXPECT_EQ(state.status().sessions(0).nodes(), 2);
+        EXPECT_EQ(state.status().sessions(0).cycles(), 0);
+    }
+    // Garbage bytes and an oversized message: typed errors too, and the daemon still serves.
+    std::string reply;
+    ASSERT_TRUE(client_->Call(std::string("\xff\x01garbage", 9), reply, 60000));
+    v1::Reply garbage;
+    ASSERT_TRUE(garbage.ParseFromString(reply));
+    EXPECT_EQ(garbage.error().code(), v1::ERROR_CODE_PARSE);
+    ASSERT_TRUE(client_->Call(std::string(3 << 19, 'x'), reply, 60000));  // 1.5 MiB
+    v1::Reply large;
+    ASSERT_TRUE(large.ParseFromString(reply));
+    EXPECT_EQ(large.error().code(), v1::ERROR_CODE_TOO_LARGE);
+    v1::Request status;
+    status.mutable_status();
+    EXPECT_TRUE(Call(status).has_status());
+}
+
+}  // namespace
+}  // namespace leaflux
