@@ -5,6 +5,7 @@
 #include <cmath>
 #include <tuple>
 
+#include "solver/generator.h"
 #include "solver/solve.h"
 #include "tests/scene_builders.h"
 
@@ -74,30 +75,6 @@ TEST(HrcViewFactor, MatchesHowellWithinOnePercent) {
     }
 }
 
-}  // namespace
-}  // namespace leaflux
-
-namespace leaflux {
-namespace {
-using namespace leaflux::testing;
-
-// A closed cube whose inner faces emit E and reflect ρ: B = E / (1 − ρ) on every face.
-Scene HrcFurnace(double rho, double exitance) {
-    Scene scene = OneBandScene({{"wall", Opaque(rho)}});
-    const glm::dvec3 p[8] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
-                             {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
-    const int faces[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1},
-                             {1, 5, 6, 2}, {2, 6, 7, 3}, {3, 7, 4, 0}};
-    for (int f = 0; f < 6; ++f) {
-        scene.sources.emitters.push_back(
-            {"face" + std::to_string(f),
-             Quad(p[faces[f][0]], p[faces[f][1]], p[faces[f][2]], p[faces[f][3]]),
-             {exitance},
-             "wall"});
-    }
-    return scene;
-}
-
 // Hierarchical radiosity does not make form factors sum to one exactly; an excess δ comes
 // back as B = E / (1 − ρ(1 + δ)), so the error grows as 1/(1 − ρ): within 1 % for ρ ≤ 0.9
 // at ε = 1e-6, and for ρ = 0.99 (stiff) a converged, finite answer within 3 %.
@@ -105,7 +82,7 @@ TEST(HrcFurnace, RadiosityIsEmittanceOverOneMinusRho) {
     const double cases[][2] = {{0.5, 0.01}, {0.9, 0.01}, {0.99, 0.03}};
     for (const auto& [rho, tolerance] : cases) {
         SCOPED_TRACE(rho);
-        const Scene scene = HrcFurnace(rho, 10.0);
+        const Scene scene = Furnace(rho, 10.0);
         scene.Validate();
         const PreparedScene prepared(scene);
         const Solution s = SolveWithHrc(prepared, 1e-6);
@@ -122,8 +99,6 @@ TEST(HrcFurnace, RadiosityIsEmittanceOverOneMinusRho) {
 
 }  // namespace
 }  // namespace leaflux
-
-#include "solver/generator.h"
 
 namespace leaflux {
 namespace {
@@ -189,12 +164,6 @@ TEST(HrcTree, StiffLeavesGiveAFiniteConvergedAnswer) {
         EXPECT_GE(light[0].irradianceUpperWm2, 0.0);
     }
 }
-
-}  // namespace
-}  // namespace leaflux
-
-namespace leaflux {
-namespace {
 
 // Extreme scenes: finite, converged, and within 5 % of the Monte Carlo reference on every
 // side that gets at least 1 % of the scene's brightest irradiance.

@@ -153,25 +153,6 @@ TEST_P(ViewFactor, BlackReceiverMatchesHowell) {
 
 INSTANTIATE_TEST_SUITE_P(Howell, ViewFactor, ::testing::Range(0, 8));
 
-// A closed cube whose inner faces emit E and reflect ρ: B = E / (1 − ρ) everywhere, and
-// each face receives B from the others (the form factors of a closed box sum to 1).
-Scene Furnace(double rho, double exitance) {
-    Scene scene = OneBandScene({{"wall", Opaque(rho)}});
-    const glm::dvec3 p[8] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
-                             {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
-    // Counter-clockwise seen from inside: upper sides face into the box.
-    const int faces[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1},
-                             {1, 5, 6, 2}, {2, 6, 7, 3}, {3, 7, 4, 0}};
-    for (int f = 0; f < 6; ++f) {
-        scene.sources.emitters.push_back(
-            {"face" + std::to_string(f),
-             Quad(p[faces[f][0]], p[faces[f][1]], p[faces[f][2]], p[faces[f][3]]),
-             {exitance},
-             "wall"});
-    }
-    return scene;
-}
-
 TEST(Furnace, RadiosityIsEmittanceOverOneMinusRho) {
     for (double rho : {0.5, 0.9}) {
         SCOPED_TRACE(rho);

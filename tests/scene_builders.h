@@ -73,4 +73,23 @@ inline Sun SunAt(double elevationDeg, double azimuthDeg, double irradiance) {
             0.0};
 }
 
+// A closed unit cube whose inner faces ("face0".."face5") emit `exitance` and reflect ρ:
+// B = E / (1 − ρ) everywhere (the form factors of a closed box sum to 1).
+inline Scene Furnace(double rho, double exitance) {
+    Scene scene = OneBandScene({{"wall", Opaque(rho)}});
+    const glm::dvec3 p[8] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                             {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    // Counter-clockwise seen from inside: upper sides face into the box.
+    const int faces[6][4] = {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1},
+                             {1, 5, 6, 2}, {2, 6, 7, 3}, {3, 7, 4, 0}};
+    for (int f = 0; f < 6; ++f) {
+        scene.sources.emitters.push_back(
+            {"face" + std::to_string(f),
+             Quad(p[faces[f][0]], p[faces[f][1]], p[faces[f][2]], p[faces[f][3]]),
+             {exitance},
+             "wall"});
+    }
+    return scene;
+}
+
 }  // namespace leaflux::testing

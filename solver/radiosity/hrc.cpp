@@ -908,28 +908,24 @@ void HrcSolver<kBands>::Outputs(Solution& solution) {
 
 }  // namespace
 
+// The solver instantiated for the scene's band count, 1 to kMaxBands.
+template <int kBands>
+Solution SolveWithBands(const Scene& scene, const FlatScene& flat, const RayScene& rays,
+                        const HrcOptions& options) {
+    if constexpr (kBands > kMaxBands) {
+        throw InternalError("hrc: a scene has 1 to " + std::to_string(kMaxBands) + " bands");
+    } else {
+        if (static_cast<int>(scene.bands.size()) == kBands) {
+            return HrcSolver<kBands>(scene, flat, rays, options).Run();
+        }
+        return SolveWithBands<kBands + 1>(scene, flat, rays, options);
+    }
+}
+
 Solution SolveHrc(const Scene& scene, const FlatScene& flat, const RayScene& rays,
                   const HrcOptions& options) {
     LEAFLUX_CHECK(options.directionLevel >= 0 && options.directionLevel <= 4);
-    switch (scene.bands.size()) {
-        case 1:
-            return HrcSolver<1>(scene, flat, rays, options).Run();
-        case 2:
-            return HrcSolver<2>(scene, flat, rays, options).Run();
-        case 3:
-            return HrcSolver<3>(scene, flat, rays, options).Run();
-        case 4:
-            return HrcSolver<4>(scene, flat, rays, options).Run();
-        case 5:
-            return HrcSolver<5>(scene, flat, rays, options).Run();
-        case 6:
-            return HrcSolver<6>(scene, flat, rays, options).Run();
-        case 7:
-            return HrcSolver<7>(scene, flat, rays, options).Run();
-        case 8:
-            return HrcSolver<8>(scene, flat, rays, options).Run();
-    }
-    throw InternalError("hrc: a scene has 1 to " + std::to_string(kMaxBands) + " bands");
+    return SolveWithBands<1>(scene, flat, rays, options);
 }
 
 }  // namespace leaflux
