@@ -97,12 +97,6 @@ TEST(HrcFurnace, RadiosityIsEmittanceOverOneMinusRho) {
     }
 }
 
-}  // namespace
-}  // namespace leaflux
-
-namespace leaflux {
-namespace {
-
 // A 300-leaf generated tree under a sun and a Turtle-like sky, NIR-like leaves.
 Scene SmallTree(BandOptics leaf) {
     Scene scene;
