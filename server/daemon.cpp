@@ -156,11 +156,6 @@ Scene Session::Next(const v1::Cycle& cycle) const {
     return next;
 }
 
-void Session::Replace(Scene scene, MeshLibrary meshes) {
-    scene_ = std::move(scene);
-    meshes_ = std::move(meshes);
-}
-
 v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outputs) const {
     std::vector<int> wanted;
     for (const std::string& band : outputs.bands()) {
@@ -314,16 +309,22 @@ v1::Reply Daemon::RunCycle(const v1::Cycle& request) {
 }
 
 v1::Reply Daemon::Resynchronise(const v1::Resync& request) {
-    if (request.session().empty())
-        throw InputError(ErrorCode::kInvalidArgument, "session", "is empty");
-    Scene scene = FromProto(request.scene(), "");
-    auto it = sessions_.find(request.session());
-    if (it == sessions_.end()) {
-        throw UnknownSession("unknown session '" + request.session() + "': open a new one");
+    if (request.session().empty()) throw InputError(ErrorCode::kInvalidArgument, "session", "is empty");
+    if (request.scene().imports_size() > 0 || request.scene().can_lights_size() > 0) {
+        throw InputError(ErrorCode::kUnsupported, "scene.imports", "the daemon reads no files: send the geometry");
     }
-    it->second->Replace(std::move(scene), MeshesFromProto(request.scene()));
+    Scene scene = FromProto(request.scene(), "");
+    SolverSettings settings = SettingsFromProto(request.settings());
+    auto it = sessions_.find(request.session());
+    if (it == sessions_.end() && sessions_.size() >= limits_.maxSessions) {
+        throw InputError(ErrorCode::kInvalidArgument, "resync",
+                         "the daemon serves at most " + std::to_string(limits_.maxSessions) + " sessions");
+    }
+    sessions_[request.session()] =
+        std::make_unique<Session>(std::move(scene), MeshesFromProto(request.scene()), std::move(settings));
+    spdlog::info("session {} resynchronised", request.session());
     v1::Reply reply;
-    reply.mutable_done();
+    reply.mutable_opened()->set_session(request.session());
     return reply;
 }
 

@@ -28,7 +28,6 @@ class Session {
     // it for what the cycle's outputs ask, and only then keeps it. Throws InputError
     // (naming the field or node) and leaves the session as it was otherwise.
     v1::CycleResult Run(const v1::Cycle& cycle);
-    void Replace(Scene scene, MeshLibrary meshes);
 
     const Scene& Current() const { return scene_; }
     std::int64_t Cycles() const { return cycles_; }

@@ -228,6 +228,193 @@ TEST_F(DaemonOnLoopback, AnswersEveryBadRequestWithATypedErrorAndChangesNothing)
              return r;
          },
          v1::ERROR_CODE_INVALID_ARGUMENT, "optics[leaf].bands[PAR]", 0},
+        {"frame of five numbers",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Node leaf = Leaf(8, 1, 0.0);
+             for (int k = 0; k < 5; ++k) leaf.mutable_frame()->add_m(1.0);
+             *r.mutable_cycle()->mutable_delta()->add_added() = leaf;
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "frame", 8},
+        {"singular frame",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Node leaf = Leaf(8, 1, 0.0);
+             for (int k = 0; k < 12; ++k) leaf.mutable_frame()->add_m(0.0);
+             *r.mutable_cycle()->mutable_delta()->add_added() = leaf;
+             return r;
+         },
+         v1::ERROR_CODE_DEGENERATE, "frame", 8},
+        {"unknown optics",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Node leaf = Leaf(9, 1, 0.0);
+             leaf.mutable_organ()->set_optics("bark");
+             *r.mutable_cycle()->mutable_delta()->add_added() = leaf;
+             return r;
+         },
+         v1::ERROR_CODE_NOT_FOUND, "organ.optics", 9},
+        {"unknown mesh_ref",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Node leaf = Leaf(10, 1, 0.0);
+             leaf.mutable_organ()->set_mesh_ref("nope");
+             *r.mutable_cycle()->mutable_delta()->add_added() = leaf;
+             return r;
+         },
+         v1::ERROR_CODE_NOT_FOUND, "organ.mesh_ref", 10},
+        {"positions not in triples",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Node leaf = Leaf(11, 1, 0.0);
+             leaf.mutable_organ()->mutable_mesh()->add_positions(1.0);
+             *r.mutable_cycle()->mutable_delta()->add_added() = leaf;
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "organ.mesh.positions", 11},
+        {"triangle beyond the positions",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Node leaf = Leaf(12, 1, 0.0);
+             leaf.mutable_organ()->mutable_mesh()->set_triangles(5, 40);
+             *r.mutable_cycle()->mutable_delta()->add_added() = leaf;
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "organ.mesh.triangles[1]", 12},
+        {"infinite age",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Node leaf = Leaf(13, 1, 0.0);
+             leaf.set_age(std::numeric_limits<double>::infinity());
+             *r.mutable_cycle()->mutable_delta()->add_added() = leaf;
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "age", 13},
+        {"NaN attribute",
+         [nan](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Node leaf = Leaf(14, 1, 0.0);
+             (*leaf.mutable_attributes())["vigour"] = nan;
+             *r.mutable_cycle()->mutable_delta()->add_added() = leaf;
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "attributes[vigour]", 14},
+        {"an id added twice",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             *r.mutable_cycle()->mutable_delta()->add_added() = Leaf(15, 1, 0.0);
+             *r.mutable_cycle()->mutable_delta()->add_added() = Leaf(15, 1, 1.0);
+             return r;
+         },
+         v1::ERROR_CODE_ALREADY_EXISTS, "", 15},
+        {"id zero",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             *r.mutable_cycle()->mutable_delta()->add_added() = Leaf(0, 1, 0.0);
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "nodes.id", 0},
+        {"organ name used twice",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Node leaf = Leaf(16, 1, 3.0);
+             leaf.set_name("leaf2");
+             *r.mutable_cycle()->mutable_delta()->add_added() = leaf;
+             return r;
+         },
+         v1::ERROR_CODE_ALREADY_EXISTS, "name", 16},
+        {"sun with no direction",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             (*r.mutable_cycle()->add_suns()->mutable_normal_irradiance())["PAR"] = 1.0;
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "suns[0].direction", 0},
+        {"sun in an unknown band",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Sun* sun = r.mutable_cycle()->add_suns();
+             sun->mutable_direction()->set_z(1.0);
+             (*sun->mutable_normal_irradiance())["UV"] = 1.0;
+             return r;
+         },
+         v1::ERROR_CODE_NOT_FOUND, "suns[0].normal_irradiance[UV]", 0},
+        {"sun missing a band",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             r.mutable_cycle()->add_suns()->mutable_direction()->set_z(1.0);
+             return r;
+         },
+         v1::ERROR_CODE_NOT_FOUND, "suns[0].normal_irradiance", 0},
+        {"negative sun",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Sun* sun = r.mutable_cycle()->add_suns();
+             sun->mutable_direction()->set_z(1.0);
+             (*sun->mutable_normal_irradiance())["PAR"] = -3.0;
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "suns[0].normal_irradiance[PAR]", 0},
+        {"sun as wide as the sky",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Sun* sun = r.mutable_cycle()->add_suns();
+             sun->mutable_direction()->set_z(1.0);
+             sun->set_angular_radius_deg(45.0);
+             (*sun->mutable_normal_irradiance())["PAR"] = 3.0;
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "suns[0].angular_radius_deg", 0},
+        {"no band at opening",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             r.mutable_open_session()->mutable_scene()->clear_bands();
+             return r;
+         },
+         v1::ERROR_CODE_NOT_FOUND, "", 0},
+        {"epsilon beyond 1",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             r.mutable_open_session()->mutable_settings()->set_epsilon(3.0);
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "settings.epsilon", 0},
+        {"negative samples",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             r.mutable_open_session()->mutable_settings()->set_samples(-4);
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "settings.samples", 0},
+        {"files to import",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             r.mutable_open_session()->mutable_scene()->add_imports()->set_path("/etc/passwd.obj");
+             return r;
+         },
+         v1::ERROR_CODE_UNSUPPORTED, "scene.imports", 0},
+        {"close of an unknown session",
+         [](const std::string&) {
+             v1::Request r;
+             r.mutable_close_session()->set_session("gone");
+             return r;
+         },
+         v1::ERROR_CODE_UNKNOWN_SESSION, "session", 0},
+        {"status of an unknown session",
+         [](const std::string&) {
+             v1::Request r;
+             r.mutable_status()->set_session("gone");
+             return r;
+         },
+         v1::ERROR_CODE_UNKNOWN_SESSION, "session", 0},
+        {"resync without a session",
+         [](const std::string&) {
+             v1::Request r;
+             *r.mutable_resync()->mutable_scene() = OpenRequest().open_session().scene();
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "session", 0},
         {"no body", [](const std::string&) { return v1::Request(); }, v1::ERROR_CODE_UNSUPPORTED,
          "body", 0},
         {"newer protocol",
@@ -268,6 +455,42 @@ TEST_F(DaemonOnLoopback, AnswersEveryBadRequestWithATypedErrorAndChangesNothing)
     v1::Request status;
     status.mutable_status();
     EXPECT_TRUE(Call(status).has_status());
+}
+
+// The daemon dies between cycles; the client, told the session is unknown, resyncs with
+// the whole scene it keeps and goes on: the results are those the first daemon gave.
+TEST(DaemonRestart, ClientResyncsAndContinuesWithIdenticalResults) {
+    v1::Request open = OpenRequest();
+    v1::Request grow = CycleRequest("", 2);
+    *grow.mutable_cycle()->mutable_delta()->add_added() = Leaf(3, 1, 0.02, 0.9);
+
+    auto first = std::make_unique<Daemon>();
+    const std::string session = first->Handle(open).opened().session();
+    grow.mutable_cycle()->set_session(session);
+    const v1::Reply before = first->Handle(grow);
+    ASSERT_TRUE(before.has_cycle()) << before.DebugString();
+    first.reset();  // killed
+
+    Daemon second;
+    const v1::Reply lost = second.Handle(grow);
+    ASSERT_TRUE(lost.has_error());
+    EXPECT_EQ(lost.error().code(), v1::ERROR_CODE_UNKNOWN_SESSION);
+    v1::Request resync;
+    resync.mutable_resync()->set_session(session);
+    *resync.mutable_resync()->mutable_scene() = open.open_session().scene();
+    *resync.mutable_resync()->mutable_settings() = open.open_session().settings();
+    const v1::Reply again = second.Handle(resync);
+    ASSERT_TRUE(again.has_opened()) << again.DebugString();
+    EXPECT_EQ(again.opened().session(), session);
+    const v1::Reply after = second.Handle(grow);
+    ASSERT_TRUE(after.has_cycle()) << after.DebugString();
+    ASSERT_EQ(after.cycle().organs_size(), before.cycle().organs_size());
+    for (int i = 0; i < after.cycle().organs_size(); ++i) {
+        EXPECT_EQ(after.cycle().organs(i).bands(0).irradiance_upper_wm2(),
+                  before.cycle().organs(i).bands(0).irradiance_upper_wm2());
+        EXPECT_EQ(after.cycle().organs(i).bands(0).irradiance_lower_wm2(),
+                  before.cycle().organs(i).bands(0).irradiance_lower_wm2());
+    }
 }
 
 }  // namespace
