@@ -309,19 +309,22 @@ v1::Reply Daemon::RunCycle(const v1::Cycle& request) {
 }
 
 v1::Reply Daemon::Resynchronise(const v1::Resync& request) {
-    if (request.session().empty()) throw InputError(ErrorCode::kInvalidArgument, "session", "is empty");
+    if (request.session().empty())
+        throw InputError(ErrorCode::kInvalidArgument, "session", "is empty");
     if (request.scene().imports_size() > 0 || request.scene().can_lights_size() > 0) {
-        throw InputError(ErrorCode::kUnsupported, "scene.imports", "the daemon reads no files: send the geometry");
+        throw InputError(ErrorCode::kUnsupported, "scene.imports",
+                         "the daemon reads no files: send the geometry");
     }
     Scene scene = FromProto(request.scene(), "");
     SolverSettings settings = SettingsFromProto(request.settings());
     auto it = sessions_.find(request.session());
     if (it == sessions_.end() && sessions_.size() >= limits_.maxSessions) {
-        throw InputError(ErrorCode::kInvalidArgument, "resync",
-                         "the daemon serves at most " + std::to_string(limits_.maxSessions) + " sessions");
+        throw InputError(
+            ErrorCode::kInvalidArgument, "resync",
+            "the daemon serves at most " + std::to_string(limits_.maxSessions) + " sessions");
     }
-    sessions_[request.session()] =
-        std::make_unique<Session>(std::move(scene), MeshesFromProto(request.scene()), std::move(settings));
+    sessions_[request.session()] = std::make_unique<Session>(
+        std::move(scene), MeshesFromProto(request.scene()), std::move(settings));
     spdlog::info("session {} resynchronised", request.session());
     v1::Reply reply;
     reply.mutable_opened()->set_session(request.session());

@@ -1,0 +1,136 @@
+// leafluxd over loopback TCP: the protocol's own cost (Status round trips, a cycle with an
+// empty delta on a one-leaf scene) and the latency of cycles of a plant growing to 1,000
+// and 10,000 leaves (HRC, ε = 1e-4), one tenth of the plant added per cycle.
+// Run: build/release/tests/leaflux_bench_daemon [out.csv]
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <thread>
+
+#include "server/daemon.h"
+#include "server/transport.h"
+#include "solver/generator.h"
+
+namespace leaflux {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+class Loopback {
+  public:
+    Loopback() : server_(context_, "tcp://127.0.0.1:*") {
+        thread_ = std::thread([this] {
+            server_.Serve([this](const std::string& r) { return daemon_.Handle(r); },
+                          [] { return std::string(); }, [] { return false; }, stop_);
+        });
+        client_ = std::make_unique<ClientConnection>(context_, server_.Endpoint());
+    }
+    ~Loopback() {
+        stop_ = true;
+        thread_.join();
+    }
+    v1::Reply Call(const v1::Request& request) {
+        std::string bytes, reply;
+        request.SerializeToString(&bytes);
+        client_->Call(bytes, reply);
+        v1::Reply decoded;
+        decoded.ParseFromString(reply);
+        return decoded;
+    }
+
+  private:
+    zmq::context_t context_;
+    Daemon daemon_;
+    RouterServer server_;
+    std::unique_ptr<ClientConnection> client_;
+    std::atomic<bool> stop_{false};
+    std::thread thread_;
+};
+
+double Seconds(Clock::time_point since) {
+    return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+// The scene of a generated tree, without its nodes, and the nodes in parent-first order.
+v1::Scene TreeScene(int leaves, std::vector<v1::Node>& nodes) {
+    Scene scene;
+    scene.bands = {{"PAR"}, {"NIR"}};
+    scene.optics = {{"leaf", {{0.1, 0.1, 0.05, 0.05}, {0.45, 0.45, 0.45, 0.45}}},
+                    {"stem", {{0.1, 0.1, 0, 0}, {0.4, 0.4, 0, 0}}}};
+    TreeParameters tree;
+    tree.leafCount = leaves;
+    AddTree(scene, tree, {0, 0, 0});
+    scene.sources.suns.push_back({glm::normalize(glm::dvec3(0.3, -0.4, 0.8)), {400.0, 350.0}, 0.0});
+    scene.sources.skies.push_back(
+        {SkyModel::kCieOvercast, {100.0, 60.0}, SkyDiscretization::kTurtle46});
+    v1::Scene message = ToProto(scene);
+    nodes.assign(message.nodes().begin(), message.nodes().end());
+    message.clear_nodes();
+    return message;
+}
+
+struct Row {
+    std::string what;
+    int leaves, cycle, organs;
+    double roundTripMs, solveMs;
+};
+
+}  // namespace
+}  // namespace leaflux
+
+int main(int argc, char** argv) {
+    using namespace leaflux;
+    std::vector<Row> rows;
+    Loopback daemon;
+    {
+        v1::Request status;
+        status.mutable_status();
+        constexpr int kCalls = 2000;
+        const auto start = Clock::now();
+        for (int i = 0; i < kCalls; ++i) daemon.Call(status);
+        rows.push_back({"status", 0, 0, 0, 1e3 * Seconds(start) / kCalls, 0.0});
+    }
+    for (int leaves : {1000, 10000}) {
+        std::vector<v1::Node> nodes;
+        v1::Request open;
+        *open.mutable_open_session()->mutable_scene() = TreeScene(leaves, nodes);
+        open.mutable_open_session()->mutable_settings()->set_epsilon(1e-4);
+        const std::string session = daemon.Call(open).opened().session();
+        constexpr int kCycles = 10;
+        std::size_t next = 0;
+        for (int c = 1; c <= kCycles; ++c) {
+            v1::Request request;
+            v1::Cycle* cycle = request.mutable_cycle();
+            cycle->set_session(session);
+            cycle->set_number(c);
+            cycle->mutable_outputs()->set_leaves(true);
+            const std::size_t until = nodes.size() * c / kCycles;
+            for (; next < until; ++next) *cycle->mutable_delta()->add_added() = nodes[next];
+            const auto start = Clock::now();
+            const v1::Reply reply = daemon.Call(request);
+            rows.push_back({"growing_tree", leaves, c, reply.cycle().organs_size(),
+                            1e3 * Seconds(start), 1e3 * reply.cycle().statistics().wall_seconds()});
+        }
+        // The same plant again with nothing changed: the protocol and the solve alone.
+        v1::Request same;
+        same.mutable_cycle()->set_session(session);
+        same.mutable_cycle()->set_number(kCycles + 1);
+        const auto start = Clock::now();
+        const v1::Reply reply = daemon.Call(same);
+        rows.push_back({"empty_delta", leaves, kCycles + 1, 0, 1e3 * Seconds(start),
+                        1e3 * reply.cycle().statistics().wall_seconds()});
+    }
+    const char* path = argc > 1 ? argv[1] : "daemon_bench.csv";
+    std::ofstream csv(path);
+    csv << "what,leaves,cycle,organs,round_trip_ms,solve_ms,overhead_ms\n";
+    std::printf("%-14s %7s %6s %7s %14s %10s %12s\n", "what", "leaves", "cycle", "organs",
+                "round_trip_ms", "solve_ms", "overhead_ms");
+    for (const Row& r : rows) {
+        csv << r.what << ',' << r.leaves << ',' << r.cycle << ',' << r.organs << ','
+            << r.roundTripMs << ',' << r.solveMs << ',' << r.roundTripMs - r.solveMs << '\n';
+        std::printf("%-14s %7d %6d %7d %14.3f %10.3f %12.3f\n", r.what.c_str(), r.leaves, r.cycle,
+                    r.organs, r.roundTripMs, r.solveMs, r.roundTripMs - r.solveMs);
+    }
+    std::printf("wrote %s\n", path);
+    return 0;
+}
