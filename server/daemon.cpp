@@ -6,6 +6,7 @@
 #include <set>
 #include <unordered_map>
 
+#include "server/executor.h"
 #include "solver/error.h"
 
 namespace leaflux {
@@ -99,12 +100,21 @@ v1::Reply ErrorReply(v1::ErrorCode code, const std::string& message, const std::
 }
 
 Session::Session(Scene scene, MeshLibrary meshes, SolverSettings settings)
-    : scene_(std::move(scene)), meshes_(std::move(meshes)), settings_(std::move(settings)) {}
+    : scene_(std::move(scene)), meshes_(std::move(meshes)), settings_(std::move(settings)) {
+    Count();
+}
+
+void Session::Count() {
+    nodes_ = static_cast<int>(scene_.nodes.size());
+    organs_ = static_cast<int>(std::count_if(scene_.nodes.begin(), scene_.nodes.end(),
+                                             [](const Node& n) { return n.organ.has_value(); }));
+}
 
 v1::CycleResult Session::Run(const v1::Cycle& cycle) {
     Scene next = Next(cycle);
     v1::CycleResult result = Solve(next, cycle.outputs());
     scene_ = std::move(next);
+    Count();
     ++cycles_;
     return result;
 }
@@ -225,8 +235,20 @@ std::string Daemon::Handle(const std::string& bytes) {
     return out;
 }
 
+std::string Daemon::KeyOf(const v1::Request& request) {
+    switch (request.body_case()) {
+        case v1::Request::kCycle:
+            return request.cycle().session();
+        case v1::Request::kResync:
+            return request.resync().session();
+        case v1::Request::kCloseSession:
+            return request.close_session().session();
+        default:
+            return "";
+    }
+}
+
 v1::Reply Daemon::Handle(const v1::Request& request) {
-    std::lock_guard lock(mutex_);
     ++requests_;
     v1::Reply reply;
     try {  // the one place a request's failure is caught
@@ -271,28 +293,34 @@ v1::Reply Daemon::Handle(const v1::Request& request) {
     return reply;
 }
 
-Session& Daemon::Find(const std::string& id) {
+std::shared_ptr<Session> Daemon::Find(const std::string& id) {
+    std::lock_guard lock(mutex_);
     const auto it = sessions_.find(id);
     if (it == sessions_.end())
         throw UnknownSession("unknown session '" + id + "': open or resync it");
-    return *it->second;
+    return it->second;
 }
 
 v1::Reply Daemon::Open(const v1::OpenSession& request) {
-    if (sessions_.size() >= limits_.maxSessions) {
-        throw InputError(
-            ErrorCode::kInvalidArgument, "open_session",
-            "the daemon serves at most " + std::to_string(limits_.maxSessions) + " sessions");
-    }
     if (request.scene().imports_size() > 0 || request.scene().can_lights_size() > 0) {
         throw InputError(ErrorCode::kUnsupported, "scene.imports",
                          "the daemon reads no files: send the geometry");
     }
     Scene scene = FromProto(request.scene(), "");
     SolverSettings settings = SettingsFromProto(request.settings());
-    const std::string id = "s" + std::to_string(nextSession_++);
-    sessions_[id] = std::make_unique<Session>(std::move(scene), MeshesFromProto(request.scene()),
-                                              std::move(settings));
+    auto session = std::make_shared<Session>(std::move(scene), MeshesFromProto(request.scene()),
+                                             std::move(settings));
+    std::string id;
+    {
+        std::lock_guard lock(mutex_);
+        if (sessions_.size() >= limits_.maxSessions) {
+            throw InputError(
+                ErrorCode::kInvalidArgument, "open_session",
+                "the daemon serves at most " + std::to_string(limits_.maxSessions) + " sessions");
+        }
+        id = "s" + std::to_string(nextSession_++);
+        sessions_[id] = std::move(session);
+    }
     spdlog::info("session {} opened", id);
     v1::Reply reply;
     reply.mutable_opened()->set_session(id);
@@ -300,9 +328,9 @@ v1::Reply Daemon::Open(const v1::OpenSession& request) {
 }
 
 v1::Reply Daemon::RunCycle(const v1::Cycle& request) {
-    Session& session = Find(request.session());
+    const std::shared_ptr<Session> session = Find(request.session());
     v1::Reply reply;
-    *reply.mutable_cycle() = session.Run(request);
+    *reply.mutable_cycle() = session->Run(request);
     reply.mutable_cycle()->set_session(request.session());
     reply.mutable_cycle()->set_number(request.number());
     return reply;
@@ -317,14 +345,17 @@ v1::Reply Daemon::Resynchronise(const v1::Resync& request) {
     }
     Scene scene = FromProto(request.scene(), "");
     SolverSettings settings = SettingsFromProto(request.settings());
-    auto it = sessions_.find(request.session());
-    if (it == sessions_.end() && sessions_.size() >= limits_.maxSessions) {
-        throw InputError(
-            ErrorCode::kInvalidArgument, "resync",
-            "the daemon serves at most " + std::to_string(limits_.maxSessions) + " sessions");
+    auto session = std::make_shared<Session>(std::move(scene), MeshesFromProto(request.scene()),
+                                             std::move(settings));
+    {
+        std::lock_guard lock(mutex_);
+        if (!sessions_.count(request.session()) && sessions_.size() >= limits_.maxSessions) {
+            throw InputError(
+                ErrorCode::kInvalidArgument, "resync",
+                "the daemon serves at most " + std::to_string(limits_.maxSessions) + " sessions");
+        }
+        sessions_[request.session()] = std::move(session);
     }
-    sessions_[request.session()] = std::make_unique<Session>(
-        std::move(scene), MeshesFromProto(request.scene()), std::move(settings));
     spdlog::info("session {} resynchronised", request.session());
     v1::Reply reply;
     reply.mutable_opened()->set_session(request.session());
@@ -335,26 +366,48 @@ v1::Reply Daemon::Status(const v1::StatusRequest& request) {
     v1::Reply reply;
     v1::StatusReply* status = reply.mutable_status();
     status->set_requests(requests_);
+    std::lock_guard lock(mutex_);  // counts only: never waits for a solve
     for (const auto& [id, session] : sessions_) {
         if (!request.session().empty() && id != request.session()) continue;
         v1::SessionStatus* s = status->add_sessions();
         s->set_session(id);
         s->set_cycles(session->Cycles());
-        s->set_nodes(static_cast<int>(session->Current().nodes.size()));
-        s->set_organs(static_cast<int>(
-            std::count_if(session->Current().nodes.begin(), session->Current().nodes.end(),
-                          [](const Node& n) { return n.organ.has_value(); })));
+        s->set_nodes(session->Nodes());
+        s->set_organs(session->Organs());
     }
-    if (!request.session().empty() && status->sessions_size() == 0) Find(request.session());
+    if (!request.session().empty() && status->sessions_size() == 0) {
+        throw UnknownSession("unknown session '" + request.session() + "': open or resync it");
+    }
     return reply;
 }
 
 v1::Reply Daemon::Close(const v1::CloseSession& request) {
-    Find(request.session());
-    sessions_.erase(request.session());
+    std::lock_guard lock(mutex_);
+    if (!sessions_.erase(request.session())) {
+        throw UnknownSession("unknown session '" + request.session() + "': nothing to close");
+    }
     v1::Reply reply;
     reply.mutable_done();
     return reply;
+}
+
+std::function<void(std::string, std::function<void(std::string)>)> DaemonDispatch(
+    Daemon& daemon, KeyedExecutor& executor) {
+    return [&daemon, &executor](std::string payload, std::function<void(std::string)> respond) {
+        auto request = std::make_shared<v1::Request>();
+        if (!request->ParseFromString(payload)) {
+            std::string out;
+            ErrorReply(v1::ERROR_CODE_PARSE, "the message is not a leaflux.v1.Request")
+                .SerializeToString(&out);
+            respond(std::move(out));
+            return;
+        }
+        executor.Submit(Daemon::KeyOf(*request), [&daemon, request, respond = std::move(respond)] {
+            std::string out;
+            daemon.Handle(*request).SerializeToString(&out);
+            respond(std::move(out));
+        });
+    };
 }
 
 }  // namespace leaflux

@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -29,17 +30,22 @@ class Session {
     // (naming the field or node) and leaves the session as it was otherwise.
     v1::CycleResult Run(const v1::Cycle& cycle);
 
-    const Scene& Current() const { return scene_; }
+    // What Status reports; readable while the session solves.
     std::int64_t Cycles() const { return cycles_; }
+    int Nodes() const { return nodes_; }
+    int Organs() const { return organs_; }
 
   private:
     Scene Next(const v1::Cycle& cycle) const;
     v1::CycleResult Solve(const Scene& scene, const v1::OutputRequest& outputs) const;
 
+    void Count();
+
     Scene scene_;
     MeshLibrary meshes_;
     SolverSettings settings_;
-    std::int64_t cycles_ = 0;
+    std::atomic<std::int64_t> cycles_{0};
+    std::atomic<int> nodes_{0}, organs_{0};
 };
 
 struct DaemonLimits {
@@ -52,7 +58,10 @@ class Daemon {
 
     // Answers one encoded Request with one encoded Reply.
     std::string Handle(const std::string& request);
+    // Thread-safe, provided the requests of one session come one at a time (KeyOf).
     v1::Reply Handle(const v1::Request& request);
+    // The session a request must be ordered with ("" for none: Open, Status, Shutdown).
+    static std::string KeyOf(const v1::Request& request);
 
     bool ShutdownRequested() const { return shutdown_; }
 
@@ -62,15 +71,21 @@ class Daemon {
     v1::Reply Resynchronise(const v1::Resync& request);
     v1::Reply Status(const v1::StatusRequest& request);
     v1::Reply Close(const v1::CloseSession& request);
-    Session& Find(const std::string& id);
+    std::shared_ptr<Session> Find(const std::string& id);
 
     DaemonLimits limits_;
-    std::mutex mutex_;  // one request at a time, for now
-    std::map<std::string, std::unique_ptr<Session>> sessions_;
+    std::mutex mutex_;  // guards the map and the id counter, never held while solving
+    std::map<std::string, std::shared_ptr<Session>> sessions_;
     std::uint64_t nextSession_ = 1;
-    std::int64_t requests_ = 0;
+    std::atomic<std::int64_t> requests_{0};
     std::atomic<bool> shutdown_{false};
 };
+
+class KeyedExecutor;
+// Decodes each message, runs it on `executor` in its session's order and answers through
+// the transport; garbage is answered at once.
+std::function<void(std::string, std::function<void(std::string)>)> DaemonDispatch(
+    Daemon& daemon, KeyedExecutor& executor);
 
 // An Error reply.
 v1::Reply ErrorReply(v1::ErrorCode code, const std::string& message, const std::string& field = "",

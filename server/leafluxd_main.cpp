@@ -6,6 +6,7 @@
 #include <csignal>
 
 #include "server/daemon.h"
+#include "server/executor.h"
 #include "server/transport.h"
 
 namespace {
@@ -20,11 +21,15 @@ int main(int argc, char** argv) {
     DaemonLimits limits;
     TransportLimits transport;
     std::size_t maxMegabytes = 256;
+    int workers = 2;
     app.add_option("--bind", bind, "ZeroMQ endpoint to serve (loopback by default)");
     app.add_option("--log-level", level, "trace, debug, info, warn, error")
         ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
     app.add_option("--max-sessions", limits.maxSessions, "Sessions served at once")
         ->check(CLI::Range(1, 100000));
+    app.add_option("--workers", workers,
+                   "Requests handled at once (different sessions solve in parallel)")
+        ->check(CLI::Range(1, 256));
     app.add_option("--max-message-mb", maxMegabytes, "Largest request accepted (MiB)")
         ->check(CLI::Range(1, 4096));
     CLI11_PARSE(app, argc, argv);
@@ -42,16 +47,18 @@ int main(int argc, char** argv) {
         zmq::context_t context;
         Daemon daemon(limits);
         RouterServer server(context, bind, transport);
-        spdlog::info("leafluxd serving {}", server.Endpoint());
-        server.Serve([&](const std::string& request) { return daemon.Handle(request); },
-                     [] {
-                         std::string out;
-                         ErrorReply(v1::ERROR_CODE_TOO_LARGE,
-                                    "the message exceeds the daemon's limits")
-                             .SerializeToString(&out);
-                         return out;
-                     },
-                     [&] { return daemon.ShutdownRequested(); }, stopRequested);
+        // Declared after the daemon: on the way out, in-flight requests finish first.
+        KeyedExecutor executor(workers);
+        spdlog::info("leafluxd serving {} with {} workers", server.Endpoint(), workers);
+        server.Serve(
+            DaemonDispatch(daemon, executor),
+            [] {
+                std::string out;
+                ErrorReply(v1::ERROR_CODE_TOO_LARGE, "the message exceeds the daemon's limits")
+                    .SerializeToString(&out);
+                return out;
+            },
+            [&] { return daemon.ShutdownRequested(); }, stopRequested);
         spdlog::info("leafluxd stopped");
     } catch (const std::exception& e) {
         spdlog::error("leafluxd: {}", e.what());

@@ -2,13 +2,17 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 namespace leaflux {
 
 RouterServer::RouterServer(zmq::context_t& context, const std::string& endpoint,
                            TransportLimits limits)
-    : socket_(context, zmq::socket_type::router), limits_(limits) {
+    : context_(context), socket_(context, zmq::socket_type::router), limits_(limits) {
     // ZeroMQ drops the connection of a peer whose frame exceeds maxmsgsize, with no reply:
     // set it at twice the limit, so that a message merely too large gets a typed error
     // and only one absurdly large is cut off.
@@ -19,13 +23,51 @@ RouterServer::RouterServer(zmq::context_t& context, const std::string& endpoint,
 
 std::string RouterServer::Endpoint() const { return socket_.get(zmq::sockopt::last_endpoint); }
 
-void RouterServer::Serve(const std::function<std::string(const std::string&)>& handle,
-                         const std::function<std::string()>& tooLarge,
+RouterServer::Dispatch RouterServer::Synchronous(
+    std::function<std::string(const std::string&)> handle) {
+    return [handle = std::move(handle)](std::string payload, Respond respond) {
+        respond(handle(payload));
+    };
+}
+
+void RouterServer::Serve(const Dispatch& dispatch, const std::function<std::string()>& tooLarge,
                          const std::function<bool()>& stopAfterReply,
                          const std::atomic<bool>& stop) {
-    zmq::pollitem_t items[] = {{socket_.handle(), 0, ZMQ_POLLIN, 0}};
+    // Replies come back through an outbox; a byte on an inproc pair wakes the loop.
+    struct Outbox {
+        std::mutex mutex;
+        std::deque<std::pair<std::vector<std::string>, std::string>> replies;
+        zmq::socket_t push;
+    };
+    const std::string wakeEndpoint =
+        "inproc://leaflux-outbox-" + std::to_string(reinterpret_cast<std::uintptr_t>(this));
+    zmq::socket_t pull(context_, zmq::socket_type::pull);
+    pull.bind(wakeEndpoint);
+    auto outbox = std::make_shared<Outbox>();
+    outbox->push = zmq::socket_t(context_, zmq::socket_type::push);
+    outbox->push.set(zmq::sockopt::linger, 0);
+    outbox->push.connect(wakeEndpoint);
+
+    zmq::pollitem_t items[] = {{socket_.handle(), 0, ZMQ_POLLIN, 0},
+                               {pull.handle(), 0, ZMQ_POLLIN, 0}};
     while (!stop) {
-        zmq::poll(items, 1, std::chrono::milliseconds(100));
+        zmq::poll(items, 2, std::chrono::milliseconds(100));
+        if (items[1].revents & ZMQ_POLLIN) {
+            zmq::message_t ignored;
+            while (pull.recv(ignored, zmq::recv_flags::dontwait)) {
+            }
+            std::deque<std::pair<std::vector<std::string>, std::string>> ready;
+            {
+                std::lock_guard lock(outbox->mutex);
+                ready.swap(outbox->replies);
+            }
+            for (auto& [envelope, reply] : ready) {
+                for (const std::string& frame : envelope)
+                    socket_.send(zmq::buffer(frame), zmq::send_flags::sndmore);
+                socket_.send(zmq::buffer(reply), zmq::send_flags::none);
+                if (stopAfterReply()) return;
+            }
+        }
         if (!(items[0].revents & ZMQ_POLLIN)) continue;
         // Read every frame of the message, keeping at most maxFrames of them.
         std::vector<zmq::message_t> frames;
@@ -40,21 +82,22 @@ void RouterServer::Serve(const std::function<std::string(const std::string&)>& h
             if (frames.size() < limits_.maxFrames) frames.push_back(std::move(frame));
         }
         if (frames.size() < 2) continue;  // no identity and payload: nothing to answer
-        std::string reply;
-        if (count > limits_.maxFrames || bytes > limits_.maxBytes) {
-            spdlog::warn("refused a message of {} frames, {} bytes", count, bytes);
-            reply = tooLarge();
-        } else {
-            const zmq::message_t& payload = frames.back();
-            reply = handle(std::string(static_cast<const char*>(payload.data()), payload.size()));
-        }
         // The envelope: every frame but the payload (identity, and the empty delimiter of
         // REQ and DEALER clients that send one).
-        for (std::size_t i = 0; i + 1 < frames.size(); ++i) {
-            socket_.send(zmq::buffer(frames[i].data(), frames[i].size()), zmq::send_flags::sndmore);
+        std::vector<std::string> envelope;
+        for (std::size_t i = 0; i + 1 < frames.size(); ++i)
+            envelope.push_back(frames[i].to_string());
+        Respond respond = [outbox, envelope](std::string reply) {
+            std::lock_guard lock(outbox->mutex);
+            outbox->replies.emplace_back(envelope, std::move(reply));
+            outbox->push.send(zmq::str_buffer("!"), zmq::send_flags::dontwait);
+        };
+        if (count > limits_.maxFrames || bytes > limits_.maxBytes) {
+            spdlog::warn("refused a message of {} frames, {} bytes", count, bytes);
+            respond(tooLarge());
+        } else {
+            dispatch(frames.back().to_string(), std::move(respond));
         }
-        socket_.send(zmq::buffer(reply), zmq::send_flags::none);
-        if (stopAfterReply()) return;
     }
 }
 

@@ -24,13 +24,22 @@ class RouterServer {
     // The endpoint actually bound (with the port chosen for a "*").
     std::string Endpoint() const;
 
-    // Serves until `stop` is set (checked every 100 ms) or `handle` asks to stop.
-    // `tooLarge` makes the reply to a message over the limits.
-    void Serve(const std::function<std::string(const std::string&)>& handle,
-               const std::function<std::string()>& tooLarge,
+    // Called once per message, from any thread, with its reply.
+    using Respond = std::function<void(std::string reply)>;
+    using Dispatch = std::function<void(std::string payload, Respond respond)>;
+
+    // Serves until `stop` is set (checked every 100 ms) or, after a reply has been sent,
+    // `stopAfterReply` says so. `dispatch` may answer later from another thread; the socket
+    // itself is only ever used by the thread that serves. `tooLarge` makes the reply to a
+    // message over the limits.
+    void Serve(const Dispatch& dispatch, const std::function<std::string()>& tooLarge,
                const std::function<bool()>& stopAfterReply, const std::atomic<bool>& stop);
 
+    // A Dispatch that answers at once with `handle`.
+    static Dispatch Synchronous(std::function<std::string(const std::string&)> handle);
+
   private:
+    zmq::context_t& context_;
     zmq::socket_t socket_;
     TransportLimits limits_;
 };

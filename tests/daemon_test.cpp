@@ -4,11 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <thread>
 
+#include "server/executor.h"
 #include "server/transport.h"
 
 namespace leaflux {
@@ -22,7 +24,7 @@ class DaemonOnLoopback : public ::testing::Test {
         server_ = std::make_unique<RouterServer>(context_, "tcp://127.0.0.1:*", limits);
         thread_ = std::thread([this] {
             server_->Serve(
-                [this](const std::string& r) { return daemon_.Handle(r); },
+                DaemonDispatch(daemon_, executor_),
                 [] {
                     std::string out;
                     ErrorReply(v1::ERROR_CODE_TOO_LARGE, "too large").SerializeToString(&out);
@@ -48,6 +50,7 @@ class DaemonOnLoopback : public ::testing::Test {
 
     zmq::context_t context_;
     Daemon daemon_;
+    KeyedExecutor executor_{2};
     std::unique_ptr<RouterServer> server_;
     std::unique_ptr<ClientConnection> client_;
     std::atomic<bool> stop_{false};
@@ -455,6 +458,49 @@ TEST_F(DaemonOnLoopback, AnswersEveryBadRequestWithATypedErrorAndChangesNothing)
     v1::Request status;
     status.mutable_status();
     EXPECT_TRUE(Call(status).has_status());
+}
+
+// A slow solve in one session holds back neither the status nor another session's cycles,
+// and its client leaving before the reply disturbs nobody.
+TEST_F(DaemonOnLoopback, SessionsSolveInParallelAndADepartedClientDisturbsNoOne) {
+    v1::Request slowOpen = OpenRequest();
+    v1::SolverSettings* settings = slowOpen.mutable_open_session()->mutable_settings();
+    settings->set_solver(v1::SOLVER_KIND_MONTE_CARLO);
+    settings->set_samples(1 << 24);  // seconds of work for one leaf
+    const std::string slow = Call(slowOpen).opened().session();
+    const std::string fast = Call(OpenRequest()).opened().session();
+    ASSERT_FALSE(slow.empty());
+    ASSERT_FALSE(fast.empty());
+    {
+        // Send the slow cycle and leave without waiting for it.
+        zmq::socket_t leaving(context_, zmq::socket_type::dealer);
+        leaving.set(zmq::sockopt::linger, 1000);
+        leaving.connect(server_->Endpoint());
+        std::string bytes;
+        CycleRequest(slow, 1).SerializeToString(&bytes);
+        leaving.send(zmq::message_t(), zmq::send_flags::sndmore);
+        leaving.send(zmq::buffer(bytes), zmq::send_flags::none);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the slow solve is under way
+    const auto start = std::chrono::steady_clock::now();
+    v1::Request status;
+    status.mutable_status();
+    const v1::Reply state = Call(status);
+    ASSERT_TRUE(state.has_status());
+    const v1::Reply other = Call(CycleRequest(fast, 1));
+    ASSERT_TRUE(other.has_cycle()) << other.DebugString();
+    const double waited =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    // Both answered while the slow session was still solving.
+    v1::Request slowStatus;
+    slowStatus.mutable_status()->set_session(slow);
+    EXPECT_EQ(Call(slowStatus).status().sessions(0).cycles(), 0)
+        << "answered after " << waited << " s";
+    // The departed client's cycle still completes and is kept.
+    for (int i = 0; i < 600 && Call(slowStatus).status().sessions(0).cycles() == 0; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    EXPECT_EQ(Call(slowStatus).status().sessions(0).cycles(), 1);
 }
 
 // The daemon dies between cycles; the client, told the session is unknown, resyncs with

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "server/daemon.h"
+#include "server/executor.h"
 #include "server/transport.h"
 #include "solver/generator.h"
 
@@ -20,8 +21,9 @@ class Loopback {
   public:
     Loopback() : server_(context_, "tcp://127.0.0.1:*") {
         thread_ = std::thread([this] {
-            server_.Serve([this](const std::string& r) { return daemon_.Handle(r); },
-                          [] { return std::string(); }, [] { return false; }, stop_);
+            server_.Serve(
+                DaemonDispatch(daemon_, executor_), [] { return std::string(); },
+                [] { return false; }, stop_);
         });
         client_ = std::make_unique<ClientConnection>(context_, server_.Endpoint());
     }
@@ -41,6 +43,7 @@ class Loopback {
   private:
     zmq::context_t context_;
     Daemon daemon_;
+    KeyedExecutor executor_{2};
     RouterServer server_;
     std::unique_ptr<ClientConnection> client_;
     std::atomic<bool> stop_{false};
