@@ -301,6 +301,21 @@ class HrcSolver {
         }
     }
 
+    // Splits the larger of r and s (or the other when the larger cannot be split) and
+    // refines the pairs of parts; false when neither can be split.
+    bool Split(std::uint32_t r, std::uint32_t s) {
+        const bool receiverLarger = hierarchy_[r].radius >= hierarchy_[s].radius;
+        if (receiverLarger ? Splittable(r) : Splittable(s)) {
+            SplitAndRefine(r, s, receiverLarger);
+            return true;
+        }
+        if (receiverLarger ? Splittable(s) : Splittable(r)) {
+            SplitAndRefine(r, s, !receiverLarger);
+            return true;
+        }
+        return false;
+    }
+
     void SplitAndRefine(std::uint32_t r, std::uint32_t s, bool splitReceiver) {
         const std::vector<std::uint32_t> children = hierarchy_[splitReceiver ? r : s].children;
         for (std::uint32_t child : children) {
@@ -366,16 +381,13 @@ class HrcSolver {
         }
         // A sender still dark after the direct light is linked where it stands: it may
         // light up as light bounces, and dropping it would lose that light.
+        // Geometry alone may call for a split: then no visibility rays are spent on it.
+        const double threshold = options_.epsilon * totalPower_;
+        if (sender * geometricError > threshold && Split(r, s)) return;
         const double v = Visibility(r, s);
         const double error =
             sender * (geometricError + VisibilitySpread(v, options_.visibilityRays));
-        if (error > options_.epsilon * totalPower_) {
-            const bool receiverLarger = R.radius >= S.radius;
-            if (receiverLarger ? Splittable(r) : Splittable(s))
-                return SplitAndRefine(r, s, receiverLarger);
-            if (receiverLarger ? Splittable(s) : Splittable(r))
-                return SplitAndRefine(r, s, !receiverLarger);
-        }
+        if (error > threshold && Split(r, s)) return;
         if (v <= 0.0) return;
         NodeLink link;
         link.sender = s;
@@ -404,16 +416,13 @@ class HrcSolver {
         const bool near = R.radius > 0.5 * d;
         if (!near && f.upper + f.lower <= 0.0) return;
         const double unoccluded = radiosity * (near ? 1.0 : f.upper + f.lower) * R.areaM2;
+        const double threshold = options_.epsilon * totalPower_;
+        const double geometricError = std::pow(R.radius / d, 2.0);
+        if (unoccluded * geometricError > threshold && Split(r, s)) return;
         const double v = Visibility(r, s);
-        const double error = unoccluded * (std::pow(R.radius / d, 2.0) +
-                                           VisibilitySpread(v, options_.visibilityRays));
-        if (error > options_.epsilon * totalPower_) {
-            const bool receiverLarger = R.radius >= S.radius;
-            if (receiverLarger ? Splittable(r) : Splittable(s))
-                return SplitAndRefine(r, s, receiverLarger);
-            if (receiverLarger ? Splittable(s) : Splittable(r))
-                return SplitAndRefine(r, s, !receiverLarger);
-        }
+        const double error =
+            unoccluded * (geometricError + VisibilitySpread(v, options_.visibilityRays));
+        if (error > threshold && Split(r, s)) return;
         if (v <= 0.0 || f.upper + f.lower <= 0.0) return;
         NodeLink link;
         link.sender = s;
