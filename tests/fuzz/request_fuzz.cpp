@@ -32,7 +32,8 @@ leaflux::Daemon& FuzzedDaemon() {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    std::string reply = FuzzedDaemon().Handle(std::string(reinterpret_cast<const char*>(data), size));
+    std::string reply =
+        FuzzedDaemon().Handle(std::string(reinterpret_cast<const char*>(data), size));
     leaflux::v1::Reply decoded;
     if (!decoded.ParseFromString(reply)) __builtin_trap();  // every input gets a Reply
     return 0;
