@@ -9,23 +9,12 @@ Writes OUT_DIR/error.csv and OUT_DIR/error.png and prints the table.
 """
 import argparse
 import csv
-import math
 import os
-import re
 import subprocess
 import sys
 
 from compare import errors, load
-
-def run(cmd):
-    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
-    line = out.strip().splitlines()[-1]
-    wall = float(re.search(r" in ([0-9.e+-]+) s", line).group(1))
-    cpu = float(re.search(r"cpu ([0-9.e+-]+) s", line).group(1))
-    peak = float(re.search(r"peak ([0-9]+) MiB", line).group(1))
-    residuals = re.findall(r"(\w+): incident [^;]*residual ([-0-9.e+]+) %", line)
-    return wall, cpu, peak, {band: float(r) for band, r in residuals}
-
+from summary import solve
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -44,15 +33,15 @@ def main():
                         "--out", scene], check=True, capture_output=True)
         reference = os.path.join(args.out, f"tree{leaves}_reference.csv")
         if not os.path.exists(reference):  # the reference is cached: delete it to redo it
-            run([leaflux, "solve", "--scene", scene, "--solver", "mc", "--samples",
-                 str(args.reference_samples), "--seed", "99", "--quiet", "--out", reference])
+            solve(leaflux, scene, reference,
+                  ["--solver", "mc", "--samples", str(args.reference_samples), "--seed", "99"])
         ref = load(reference)
         settings = [("mc", ["--samples", str(n)], f"samples={n}") for n in (64, 256, 1024)]
         settings += [("hrc", ["--epsilon", e], f"epsilon={e}") for e in ("1e-3", "1e-4", "1e-5", "1e-6")]
         for solver, options, label in settings:
             out = os.path.join(args.out, f"tree{leaves}_{solver}_{label}.csv")
-            wall, cpu, peak, residual = run([leaflux, "solve", "--scene", scene, "--solver", solver,
-                                             "--quiet", "--out", out] + options)
+            run = solve(leaflux, scene, out, ["--solver", solver] + options)
+            wall, cpu, peak, residual = run["wall_s"], run["cpu_s"], run["peak_mib"], run["residual_pct"]
             value = load(out)
             for band in ("PAR", "NIR"):
                 l2, mean, p95 = errors(ref, value, band)

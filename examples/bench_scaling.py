@@ -9,20 +9,9 @@ import argparse
 import csv
 import math
 import os
-import re
 import subprocess
 
-
-def solve(leaflux, scene, out, options):
-    line = subprocess.run([leaflux, "solve", "--scene", scene, "--quiet", "--out", out] + options,
-                          check=True, capture_output=True, text=True).stdout.strip().splitlines()[-1]
-    found = lambda pattern: re.search(pattern, line)
-    row = dict(wall_s=float(found(r" in ([0-9.e+-]+) s").group(1)),
-               cpu_s=float(found(r"cpu ([0-9.e+-]+) s").group(1)),
-               peak_mib=int(found(r"peak ([0-9]+) MiB").group(1)))
-    links = found(r"([0-9]+) links, ([0-9]+) elements")
-    row["links"], row["elements"] = (int(links.group(1)), int(links.group(2))) if links else ("", "")
-    return row
+from summary import solve
 
 
 def slope(xs, ys):
@@ -49,6 +38,7 @@ def main():
         for solver, options in (("hrc", ["--epsilon", args.epsilon]), ("mc", ["--samples", args.samples])):
             row = solve(leaflux, scene, os.path.join(args.out, f"tree{leaves}_{solver}.csv"),
                         ["--solver", solver] + options)
+            row.pop("residual_pct")
             rows.append(dict(leaves=leaves, solver=solver, setting=options[1], **row))
     with open(os.path.join(args.out, "scaling.csv"), "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))

@@ -1,0 +1,20 @@
+"""Runs `leaflux solve` and reads its one-line summary, for the benchmark scripts."""
+import re
+import subprocess
+
+
+def solve(leaflux, scene, out, options):
+    """Solves `scene` into `out` (CSV) and returns the summary's figures: wall_s, cpu_s,
+    peak_mib, links and elements ("" for Monte Carlo), and the energy balance residual in %
+    per band."""
+    line = subprocess.run([leaflux, "solve", "--scene", scene, "--quiet", "--out", out] + options,
+                          check=True, capture_output=True, text=True).stdout.strip().splitlines()[-1]
+    found = lambda pattern: re.search(pattern, line)
+    row = dict(wall_s=float(found(r" in ([0-9.e+-]+) s").group(1)),
+               cpu_s=float(found(r"cpu ([0-9.e+-]+) s").group(1)),
+               peak_mib=int(found(r"peak ([0-9]+) MiB").group(1)))
+    links = found(r"([0-9]+) links, ([0-9]+) elements")
+    row["links"], row["elements"] = (int(links.group(1)), int(links.group(2))) if links else ("", "")
+    row["residual_pct"] = {band: float(r) for band, r in
+                           re.findall(r"(\w+): incident [^;]*residual ([-0-9.e+]+) %", line)}
+    return row
