@@ -1,5 +1,7 @@
 #include "solver/solve.h"
 
+#include "solver/error.h"
+
 namespace leaflux {
 
 PreparedScene::PreparedScene(const Scene& scene) : scene_(scene), flat_(Flatten(scene)) {
@@ -21,6 +23,12 @@ Solution Solve(const PreparedScene& prepared, const SolverSettings& settings) {
             return SolveReference(prepared.Source(), prepared.Flat(), prepared.Rays(),
                                   settings.monteCarlo);
         case SolverKind::kHrc:
+            // Links do not wrap around a periodic tile yet: say so rather than lose the light
+            // that crosses its sides.
+            if (prepared.Source().periodic) {
+                throw InputError(ErrorCode::kUnsupported, "periodic",
+                                 "the hrc solver does not handle periodic domains yet: use mc");
+            }
             return SolveHrc(prepared.Source(), prepared.Flat(), prepared.Rays(), settings.hrc);
     }
     return {};

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <tuple>
 
+#include "solver/error.h"
 #include "solver/generator.h"
 #include "solver/solve.h"
 #include "tests/scene_builders.h"
@@ -200,6 +201,21 @@ Scene TwoLeaves(double gap, glm::dvec3 offset) {
     };
     scene.nodes.push_back(OrganNode(2, "bottom", shifted(1.0), "leaf"));
     return scene;
+}
+
+TEST(Hrc, RefusesPeriodicDomainsWithATypedError) {
+    Scene scene = TwoLeaves(0.02, glm::dvec3(0.0));
+    scene.periodic = PeriodicDomain{-1, -1, 1, 1};
+    scene.sources.suns.push_back(SunAt(60, 30, 1000));
+    scene.Validate();
+    const PreparedScene prepared(scene);
+    try {
+        SolveWithHrc(prepared, 1e-4);
+        FAIL() << "a periodic scene was solved by hrc";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.Code(), ErrorCode::kUnsupported);
+        EXPECT_EQ(e.Field(), "periodic");
+    }
 }
 
 TEST(HrcExtreme, LeavesOneMicrometreApart) {
