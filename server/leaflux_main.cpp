@@ -83,6 +83,8 @@ struct GenerateCommand {
     double spacing = 6.0, rowAzimuth = 0.0, sunElevation = 50.0, sunAzimuth = 160.0;
     double sunPar = 400.0, sunNir = 350.0, skyPar = 100.0, skyNir = 60.0;
     bool noSky = false;
+    CanopyParameters canopy;
+    bool randomCanopy = false;
     std::string skyCones = "continuous";
     std::string out;
 };
@@ -109,7 +111,13 @@ int RunGenerate(const GenerateCommand& command) {
     plantation.rowSpacingM = plantation.columnSpacingM = command.spacing;
     plantation.rowAzimuthDeg = command.rowAzimuth;
     plantation.jitterM = 0.1 * command.spacing;
-    AddPlantation(scene, plantation, "ground");
+    if (command.randomCanopy) {
+        CanopyParameters canopy = command.canopy;
+        canopy.seed = command.tree.seed;
+        AddRandomCanopy(scene, canopy);
+    } else {
+        AddPlantation(scene, plantation, "ground");
+    }
     const double h = glm::radians(command.sunElevation), a = glm::radians(command.sunAzimuth);
     scene.sources.suns.push_back(
         {{std::cos(h) * std::sin(a), std::cos(h) * std::cos(a), std::sin(h)},
@@ -270,6 +278,17 @@ int main(int argc, char** argv) {
     generateApp->add_option("--sun-azimuth", generate.sunAzimuth,
                             "Sun azimuth from north, clockwise (deg)");
     generateApp->add_flag("--no-sky", generate.noSky, "Sun only, no diffuse sky");
+    generateApp->add_flag("--random-canopy", generate.randomCanopy,
+                          "A random canopy of square leaves (spherical angles) instead of trees");
+    generateApp->add_option("--canopy-leaves", generate.canopy.leaves, "Random canopy: leaves")
+        ->check(CLI::Range(1, 10'000'000));
+    generateApp
+        ->add_option("--lai", generate.canopy.leafAreaIndex, "Random canopy: leaf area index")
+        ->check(CLI::PositiveNumber);
+    generateApp
+        ->add_option("--canopy-width", generate.canopy.widthM,
+                     "Random canopy: side of its square (m)")
+        ->check(CLI::PositiveNumber);
     generateApp
         ->add_option(
             "--sky-cones", generate.skyCones,

@@ -254,4 +254,33 @@ void AddPlantation(Scene& scene, const PlantationParameters& parameters,
     scene.environment.push_back({"ground", ground, groundOptics});
 }
 
+void AddRandomCanopy(Scene& scene, const CanopyParameters& p) {
+    if (p.leaves < 1 || !(p.leafAreaIndex > 0.0) || !(p.widthM > 0.0) || !(p.topM >= p.bottomM)) {
+        throw InputError(ErrorCode::kInvalidArgument, "canopy",
+                         "needs leaves >= 1, a positive leaf area index and width, top >= bottom");
+    }
+    Random random(StreamSeed(p.seed, 0xCA70));
+    const double side = std::sqrt(p.leafAreaIndex * p.widthM * p.widthM / p.leaves);
+    auto quad = std::make_shared<Mesh>();  // a unit square, shared, scaled by each frame
+    quad->positions = {{-0.5, -0.5, 0}, {0.5, -0.5, 0}, {0.5, 0.5, 0}, {-0.5, 0.5, 0}};
+    quad->triangles = {{0, 1, 2}, {0, 2, 3}};
+    NodeId next = 1;
+    for (const Node& node : scene.nodes) next = std::max(next, node.id + 1);
+    for (int i = 0; i < p.leaves; ++i) {
+        const glm::dvec3 centre((random.Uniform() - 0.5) * p.widthM,
+                                (random.Uniform() - 0.5) * p.widthM,
+                                p.bottomM + random.Uniform() * (p.topM - p.bottomM));
+        const glm::dvec3 normal = UniformSphere(random.Uniform(), random.Uniform());
+        const glm::dvec3 u =
+            Rotate(AnyPerpendicular(normal), normal, 2.0 * glm::pi<double>() * random.Uniform());
+        Node leaf;
+        leaf.id = next++;
+        leaf.type = NodeType::kLeaf;
+        leaf.name = "leaf" + std::to_string(i + 1);
+        leaf.organ = Organ{quad, p.leafOptics};
+        leaf.parentFromLocal = FrameOf(centre, u * side, glm::cross(normal, u) * side, normal);
+        scene.nodes.push_back(std::move(leaf));
+    }
+}
+
 }  // namespace leaflux

@@ -49,4 +49,17 @@ struct PlantationParameters {
 void AddPlantation(Scene& scene, const PlantationParameters& parameters,
                    const std::string& groundOptics);
 
+// A random canopy: square leaves of spherical angle distribution (normals uniform on the
+// sphere), centres uniform over a width × width square and between two heights, sized for
+// the leaf area index; leaves named "leaf<i>", optics `leafOptics`.
+struct CanopyParameters {
+    int leaves = 500;
+    double leafAreaIndex = 3.0;
+    double widthM = 2.0;
+    double bottomM = 0.5, topM = 1.5;
+    std::uint64_t seed = 1;
+    std::string leafOptics = "leaf";
+};
+void AddRandomCanopy(Scene& scene, const CanopyParameters& parameters);
+
 }  // namespace leaflux
