@@ -302,6 +302,15 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory) {
     for (const v1::Band& band : message.bands()) {
         scene.bands.push_back({band.name(), band.wavelength_min_nm(), band.wavelength_max_nm()});
     }
+    // Bands first: every per-band map below is read against them.
+    for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+        for (std::size_t c = 0; c < b; ++c) {
+            if (scene.bands[c].name == scene.bands[b].name) {
+                Fail(ErrorCode::kAlreadyExists, "bands[" + scene.bands[b].name + "]",
+                     "is declared twice");
+            }
+        }
+    }
     for (const v1::Optics& optics : message.optics()) {
         Optics o;
         o.id = optics.id();

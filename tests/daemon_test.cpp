@@ -418,6 +418,126 @@ TEST_F(DaemonOnLoopback, AnswersEveryBadRequestWithATypedErrorAndChangesNothing)
              return r;
          },
          v1::ERROR_CODE_INVALID_ARGUMENT, "session", 0},
+        {"optics missing a band",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             r.mutable_open_session()->mutable_scene()->add_bands()->set_name("NIR");
+             return r;
+         },
+         v1::ERROR_CODE_NOT_FOUND, "optics[leaf].bands", 0},
+        {"a band declared twice",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             r.mutable_open_session()->mutable_scene()->add_bands()->set_name("PAR");
+             return r;
+         },
+         v1::ERROR_CODE_ALREADY_EXISTS, "bands[PAR]", 0},
+        {"negative sky",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             (*r.mutable_open_session()
+                   ->mutable_scene()
+                   ->mutable_sky()
+                   ->mutable_horizontal_irradiance())["PAR"] = -1;
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "sky.horizontal_irradiance[PAR]", 0},
+        {"sky in an unknown band",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             (*r.mutable_open_session()
+                   ->mutable_scene()
+                   ->mutable_sky()
+                   ->mutable_horizontal_irradiance())["UV"] = 1;
+             return r;
+         },
+         v1::ERROR_CODE_NOT_FOUND, "sky.horizontal_irradiance[UV]", 0},
+        {"lamp of NaN exitance",
+         [nan](const std::string&) {
+             auto r = OpenRequest();
+             v1::Emitter* lamp = r.mutable_open_session()->mutable_scene()->add_emitters();
+             lamp->set_name("lamp");
+             *lamp->mutable_mesh() = Leaf(99, 0, 0.0, 2.0).organ().mesh();
+             (*lamp->mutable_exitance())["PAR"] = nan;
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "emitters[lamp].exitance[PAR]", 0},
+        {"lamp without triangles",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             v1::Emitter* lamp = r.mutable_open_session()->mutable_scene()->add_emitters();
+             lamp->set_name("lamp");
+             (*lamp->mutable_exitance())["PAR"] = 10;
+             return r;
+         },
+         v1::ERROR_CODE_DEGENERATE, "emitters[lamp].mesh", 0},
+        {"ground of unknown optics",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             v1::Surface* ground = r.mutable_open_session()->mutable_scene()->add_environment();
+             ground->set_name("ground");
+             ground->set_optics("mud");
+             *ground->mutable_mesh() = Leaf(99, 0, 0.0, 0.0).organ().mesh();
+             return r;
+         },
+         v1::ERROR_CODE_NOT_FOUND, "environment[ground].optics", 0},
+        {"empty periodic domain",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             r.mutable_open_session()->mutable_scene()->mutable_periodic()->set_x_max(1.0);
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "periodic", 0},
+        {"latitude beyond the pole",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             v1::Sun* sun = r.mutable_open_session()->mutable_scene()->mutable_suns(0);
+             sun->mutable_solar()->set_latitude_deg(95);
+             sun->mutable_solar()->set_day_of_year(100);
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "suns[0].solar.latitude_deg", 0},
+        {"a period ending before it starts",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             v1::SunPeriod* period = r.mutable_open_session()->mutable_scene()->add_sun_periods();
+             period->set_day_of_year(100);
+             period->set_start_h(14);
+             period->set_end_h(10);
+             period->set_step_h(1);
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "sun_periods[0]", 0},
+        {"negative threads",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             r.mutable_open_session()->mutable_settings()->set_threads(-2);
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "settings.threads", 0},
+        {"subdivision beyond 8",
+         [](const std::string&) {
+             auto r = OpenRequest();
+             r.mutable_open_session()->mutable_settings()->set_subdivision(20);
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "settings.subdivision", 0},
+        {"a node its own parent",
+         [](const std::string& s) {
+             auto r = CycleRequest(s, 1);
+             v1::Node leaf = Leaf(2, 2, 0.0);
+             *r.mutable_cycle()->mutable_delta()->add_updated() = leaf;
+             return r;
+         },
+         v1::ERROR_CODE_CYCLE, "parent", 2},
+        {"NaN reflectance",
+         [nan](const std::string&) {
+             auto r = OpenRequest();
+             (*r.mutable_open_session()->mutable_scene()->mutable_optics(0)->mutable_bands())["PAR"]
+                 .set_rho_lower(nan);
+             return r;
+         },
+         v1::ERROR_CODE_INVALID_ARGUMENT, "optics[leaf].bands[PAR].rho_lower", 0},
         {"no body", [](const std::string&) { return v1::Request(); }, v1::ERROR_CODE_UNSUPPORTED,
          "body", 0},
         {"newer protocol",
