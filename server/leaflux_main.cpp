@@ -139,6 +139,7 @@ int RunGenerate(const GenerateCommand& command) {
 
 struct ClientCommand {
     std::string endpoint = "tcp://127.0.0.1:5555", scene, session, delta, solver = "hrc";
+    std::string curveServerKeyFile;
     std::int64_t number = 1;
     bool leaves = true, structures = false;
     double epsilon = 1e-4;
@@ -148,8 +149,17 @@ struct ClientCommand {
 // Sends one request to leafluxd and prints the reply in protobuf text format.
 int RunClient(const ClientCommand& command, v1::Request request) {
     request.set_version(v1::PROTOCOL_VERSION_CURRENT);
+    std::string serverKey;
+    if (!command.curveServerKeyFile.empty()) {
+        std::ifstream in(command.curveServerKeyFile);
+        in >> serverKey;
+        if (serverKey.size() != 40) {
+            throw InputError(ErrorCode::kParse, command.curveServerKeyFile,
+                             "not a Z85 CurveZMQ public key");
+        }
+    }
     zmq::context_t context;
-    ClientConnection connection(context, command.endpoint);
+    ClientConnection connection(context, command.endpoint, serverKey);
     std::string bytes, answer;
     request.SerializeToString(&bytes);
     if (!connection.Call(bytes, answer, command.timeoutS * 1000)) {
@@ -303,6 +313,16 @@ int main(int argc, char** argv) {
     clientApp->require_subcommand(1);
     clientApp->add_option("--endpoint", client.endpoint, "leafluxd's endpoint");
     clientApp->add_option("--timeout", client.timeoutS, "Seconds to wait for the reply");
+    clientApp
+        ->add_option("--curve-server-key", client.curveServerKeyFile,
+                     "File with the daemon's CurveZMQ public key, when it uses one")
+        ->check(CLI::ExistingFile);
+    std::string keyPrefix;
+    CLI::App* keygenApp = app.add_subcommand("keygen", "Write a CurveZMQ key pair for leafluxd");
+    keygenApp
+        ->add_option("--out", keyPrefix,
+                     "Writes PREFIX.secret (for leafluxd) and PREFIX.public (for clients)")
+        ->required();
     CLI::App* openApp = clientApp->add_subcommand("open", "Open a session from a scene file");
     openApp->add_option("--scene", client.scene, "Scene file")
         ->required()
@@ -329,6 +349,14 @@ int main(int argc, char** argv) {
     try {
         if (solveApp->parsed()) return RunSolve(solve);
         if (generateApp->parsed()) return RunGenerate(generate);
+        if (keygenApp->parsed()) {
+            const CurveKeyPair keys = CurveKeyPair::Generate();
+            std::ofstream(keyPrefix + ".secret") << keys.secretKey << '\n';
+            std::ofstream(keyPrefix + ".public") << keys.publicKey << '\n';
+            std::cout << "wrote " << keyPrefix << ".secret and " << keyPrefix << ".public"
+                      << std::endl;
+            return 0;
+        }
         if (openApp->parsed()) return RunClient(client, OpenFromFile(client));
         if (cycleApp->parsed()) return RunClient(client, CycleFromFile(client));
         v1::Request request;

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <csignal>
+#include <fstream>
 
 #include "server/daemon.h"
 #include "server/executor.h"
@@ -22,6 +23,7 @@ int main(int argc, char** argv) {
     TransportLimits transport;
     std::size_t maxMegabytes = 256;
     int workers = 2;
+    std::string curveKeyFile;
     app.add_option("--bind", bind, "ZeroMQ endpoint to serve (loopback by default)");
     app.add_option("--log-level", level, "trace, debug, info, warn, error")
         ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
@@ -30,15 +32,29 @@ int main(int argc, char** argv) {
     app.add_option("--workers", workers,
                    "Requests handled at once (different sessions solve in parallel)")
         ->check(CLI::Range(1, 256));
+    app.add_option("--curve-secret-key", curveKeyFile,
+                   "File with the server's CurveZMQ secret key (leaflux keygen): encrypts every "
+                   "connection; required to bind anywhere but loopback")
+        ->check(CLI::ExistingFile);
     app.add_option("--max-message-mb", maxMegabytes, "Largest request accepted (MiB)")
         ->check(CLI::Range(1, 4096));
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::from_str(level));
     transport.maxBytes = maxMegabytes << 20;
-    if (bind.rfind("tcp://127.", 0) != 0 && bind.rfind("tcp://localhost", 0) != 0 &&
-        bind.rfind("ipc://", 0) != 0 && bind.rfind("inproc://", 0) != 0) {
-        spdlog::error("{}: leafluxd binds to loopback only until CurveZMQ keys are supported",
-                      bind);
+    std::string curveSecretKey;
+    if (!curveKeyFile.empty()) {
+        std::ifstream in(curveKeyFile);
+        in >> curveSecretKey;
+        if (curveSecretKey.size() != 40) {
+            spdlog::error("{}: not a Z85 CurveZMQ secret key (40 characters)", curveKeyFile);
+            return 2;
+        }
+    }
+    const bool loopback = bind.rfind("tcp://127.", 0) == 0 ||
+                          bind.rfind("tcp://localhost", 0) == 0 || bind.rfind("ipc://", 0) == 0 ||
+                          bind.rfind("inproc://", 0) == 0;
+    if (!loopback && curveSecretKey.empty()) {
+        spdlog::error("{}: binding beyond loopback needs --curve-secret-key", bind);
         return 2;
     }
     std::signal(SIGINT, OnSignal);
@@ -46,7 +62,7 @@ int main(int argc, char** argv) {
     try {
         zmq::context_t context;
         Daemon daemon(limits);
-        RouterServer server(context, bind, transport);
+        RouterServer server(context, bind, transport, curveSecretKey);
         // Declared after the daemon: on the way out, in-flight requests finish first.
         KeyedExecutor executor(workers);
         spdlog::info("leafluxd serving {} with {} workers", server.Endpoint(), workers);

@@ -10,14 +10,24 @@
 
 namespace leaflux {
 
+CurveKeyPair CurveKeyPair::Generate() {
+    char publicKey[41], secretKey[41];
+    if (zmq_curve_keypair(publicKey, secretKey) != 0) throw zmq::error_t();
+    return {publicKey, secretKey};
+}
+
 RouterServer::RouterServer(zmq::context_t& context, const std::string& endpoint,
-                           TransportLimits limits)
+                           TransportLimits limits, const std::string& curveSecretKey)
     : context_(context), socket_(context, zmq::socket_type::router), limits_(limits) {
     // ZeroMQ drops the connection of a peer whose frame exceeds maxmsgsize, with no reply:
     // set it at twice the limit, so that a message merely too large gets a typed error
     // and only one absurdly large is cut off.
     socket_.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(2 * limits_.maxBytes));
     socket_.set(zmq::sockopt::linger, 0);
+    if (!curveSecretKey.empty()) {
+        socket_.set(zmq::sockopt::curve_server, true);
+        socket_.set(zmq::sockopt::curve_secretkey, curveSecretKey);
+    }
     socket_.bind(endpoint);
 }
 
@@ -101,9 +111,17 @@ void RouterServer::Serve(const Dispatch& dispatch, const std::function<std::stri
     }
 }
 
-ClientConnection::ClientConnection(zmq::context_t& context, const std::string& endpoint)
+ClientConnection::ClientConnection(zmq::context_t& context, const std::string& endpoint,
+                                   const std::string& curveServerKey)
     : socket_(context, zmq::socket_type::dealer) {
     socket_.set(zmq::sockopt::linger, 0);
+    if (!curveServerKey.empty()) {
+        // An ephemeral client key pair: the server authenticates itself, not the client.
+        const CurveKeyPair mine = CurveKeyPair::Generate();
+        socket_.set(zmq::sockopt::curve_serverkey, curveServerKey);
+        socket_.set(zmq::sockopt::curve_publickey, mine.publicKey);
+        socket_.set(zmq::sockopt::curve_secretkey, mine.secretKey);
+    }
     socket_.connect(endpoint);
 }
 

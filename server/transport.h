@@ -16,10 +16,18 @@ struct TransportLimits {
     std::size_t maxBytes = 256u << 20;  // a message larger than this is refused
 };
 
+// CurveZMQ keys, Z85 text (40 characters). A server with a secret key encrypts every
+// connection and proves who it is; clients need its public key to talk to it.
+struct CurveKeyPair {
+    std::string publicKey, secretKey;
+    static CurveKeyPair Generate();
+};
+
 class RouterServer {
   public:
     // Binds `endpoint` (e.g. tcp://127.0.0.1:5555, tcp://127.0.0.1:* for any port).
-    RouterServer(zmq::context_t& context, const std::string& endpoint, TransportLimits limits = {});
+    RouterServer(zmq::context_t& context, const std::string& endpoint, TransportLimits limits = {},
+                 const std::string& curveSecretKey = "");
 
     // The endpoint actually bound (with the port chosen for a "*").
     std::string Endpoint() const;
@@ -47,7 +55,9 @@ class RouterServer {
 // A client connection: one request, one reply, with a timeout.
 class ClientConnection {
   public:
-    ClientConnection(zmq::context_t& context, const std::string& endpoint);
+    // `curveServerKey`: the server's public key when it speaks CurveZMQ ("" otherwise).
+    ClientConnection(zmq::context_t& context, const std::string& endpoint,
+                     const std::string& curveServerKey = "");
     // Sends `request`; false when no reply came within `timeoutMs`.
     bool Call(const std::string& request, std::string& reply, int timeoutMs = 600000);
 

@@ -623,6 +623,33 @@ TEST_F(DaemonOnLoopback, SessionsSolveInParallelAndADepartedClientDisturbsNoOne)
     EXPECT_EQ(Call(slowStatus).status().sessions(0).cycles(), 1);
 }
 
+// With a CurveZMQ secret key the daemon answers clients that know its public key, and
+// nobody else.
+TEST(DaemonCurve, AnswersOnlyClientsThatKnowItsKey) {
+    zmq::context_t context;
+    const CurveKeyPair keys = CurveKeyPair::Generate();
+    RouterServer server(context, "tcp://127.0.0.1:*", {}, keys.secretKey);
+    Daemon daemon;
+    std::atomic<bool> stop{false};
+    std::thread thread([&] {
+        server.Serve(
+            RouterServer::Synchronous([&](const std::string& r) { return daemon.Handle(r); }),
+            [] { return std::string(); }, [] { return false; }, stop);
+    });
+    v1::Request status;
+    status.mutable_status();
+    std::string bytes, reply;
+    status.SerializeToString(&bytes);
+    ClientConnection trusted(context, server.Endpoint(), keys.publicKey);
+    EXPECT_TRUE(trusted.Call(bytes, reply, 10000));
+    v1::Reply decoded;
+    EXPECT_TRUE(decoded.ParseFromString(reply) && decoded.has_status());
+    ClientConnection plain(context, server.Endpoint());
+    EXPECT_FALSE(plain.Call(bytes, reply, 500));
+    stop = true;
+    thread.join();
+}
+
 // The daemon dies between cycles; the client, told the session is unknown, resyncs with
 // the whole scene it keeps and goes on: the results are those the first daemon gave.
 TEST(DaemonRestart, ClientResyncsAndContinuesWithIdenticalResults) {
