@@ -173,12 +173,23 @@ v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outp
         if (b < 0)
             throw InputError(ErrorCode::kNotFound, "outputs.bands[" + band + "]",
                              "names no declared band");
+        if (std::find(wanted.begin(), wanted.end(), b) != wanted.end()) {
+            throw InputError(ErrorCode::kAlreadyExists, "outputs.bands[" + band + "]",
+                             "is asked twice");
+        }
         wanted.push_back(b);
     }
     if (wanted.empty()) {
         for (std::size_t b = 0; b < scene.bands.size(); ++b) wanted.push_back(static_cast<int>(b));
     }
-    const PreparedScene prepared(scene);
+    // Only the bands asked for are solved: the solver sees a scene of those alone.
+    const bool allBands = wanted.size() == scene.bands.size();
+    std::vector<int> order(wanted.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+    const Scene subset = allBands ? Scene{} : WithBands(scene, wanted);
+    const Scene& solved = allBands ? scene : subset;
+    if (!allBands) wanted = order;
+    const PreparedScene prepared(solved);
     const Solution solution = leaflux::Solve(prepared, settings_);
     v1::CycleResult result;
     if (outputs.leaves()) {
@@ -188,17 +199,17 @@ v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outp
             organ->set_node(receiver.node);
             organ->set_name(receiver.name);
             organ->set_area_m2(receiver.areaM2);
-            BandsToProto(scene, solution.light[r], wanted, organ->mutable_bands());
+            BandsToProto(solved, solution.light[r], wanted, organ->mutable_bands());
         }
     }
     if (outputs.structures()) {
-        for (const StructureLight& s : AggregateStructures(scene, prepared.Flat(), solution)) {
+        for (const StructureLight& s : AggregateStructures(solved, prepared.Flat(), solution)) {
             v1::StructureLight* structure = result.add_structures();
             structure->set_node(s.node);
             structure->set_name(s.name);
             structure->set_organs(s.organCount);
             structure->set_area_m2(s.areaM2);
-            BandsToProto(scene, s.bands, wanted, structure->mutable_bands());
+            BandsToProto(solved, s.bands, wanted, structure->mutable_bands());
         }
     }
     v1::SolveStatistics* stats = result.mutable_statistics();
@@ -212,7 +223,7 @@ v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outp
     stats->set_residual(solution.stats.residual);
     for (int b : wanted) {
         v1::EnergyBalance* balance = stats->add_balance();
-        balance->set_band(scene.bands[b].name);
+        balance->set_band(solved.bands[b].name);
         balance->set_incident_w(solution.balance[b].incidentW);
         balance->set_absorbed_w(solution.balance[b].absorbedW);
         balance->set_escaped_w(solution.balance[b].escapedW);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <type_traits>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -247,6 +248,23 @@ void Scene::Validate() const {
                     periodic->xMax > periodic->xMin && periodic->yMax > periodic->yMin,
                 ErrorCode::kInvalidArgument, "periodic", "needs x_min < x_max and y_min < y_max");
     }
+}
+
+Scene WithBands(const Scene& scene, const std::vector<int>& bands) {
+    auto pick = [&](const auto& values) {
+        std::decay_t<decltype(values)> picked;
+        for (int b : bands) picked.push_back(values.at(b));
+        return picked;
+    };
+    Scene subset = scene;
+    subset.bands = pick(scene.bands);
+    for (Optics& optics : subset.optics) optics.bands = pick(optics.bands);
+    for (Sun& sun : subset.sources.suns) sun.normalIrradianceWm2 = pick(sun.normalIrradianceWm2);
+    for (Sky& sky : subset.sources.skies)
+        sky.horizontalIrradianceWm2 = pick(sky.horizontalIrradianceWm2);
+    for (Emitter& emitter : subset.sources.emitters)
+        emitter.exitanceWm2 = pick(emitter.exitanceWm2);
+    return subset;
 }
 
 std::map<NodeId, glm::dmat4> WorldFromLocal(const Scene& scene) {

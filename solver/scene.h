@@ -97,6 +97,10 @@ struct Scene {
     void Validate() const;
 };
 
+// The scene restricted to some of its bands, in the order given: optics, suns, skies and
+// emitters keep only those bands' values. A solver then does no work for the others.
+Scene WithBands(const Scene& scene, const std::vector<int>& bands);
+
 // worldFromLocal of every node, by id. Requires a validated scene (no cycles).
 std::map<NodeId, glm::dmat4> WorldFromLocal(const Scene& scene);
 

@@ -623,6 +623,35 @@ TEST_F(DaemonOnLoopback, SessionsSolveInParallelAndADepartedClientDisturbsNoOne)
     EXPECT_EQ(Call(slowStatus).status().sessions(0).cycles(), 1);
 }
 
+// A cycle that asks for one band gets that band alone, solved for it alone.
+TEST(DaemonBands, OnlyTheRequestedBandsAreSolvedAndSent) {
+    v1::Request open = OpenRequest();
+    v1::Scene* scene = open.mutable_open_session()->mutable_scene();
+    scene->add_bands()->set_name("NIR");
+    v1::BandOptics& nir = (*scene->mutable_optics(0)->mutable_bands())["NIR"];
+    nir.set_rho_upper(0.45), nir.set_rho_lower(0.45), nir.set_tau_upper(0.45),
+        nir.set_tau_lower(0.45);
+    (*scene->mutable_suns(0)->mutable_normal_irradiance())["NIR"] = 800.0;
+    *scene->add_nodes() = Leaf(3, 1, 0.02, 0.9);
+    Daemon daemon;
+    const std::string session = daemon.Handle(open).opened().session();
+    v1::Request both = CycleRequest(session, 1);
+    const v1::Reply all = daemon.Handle(both);
+    ASSERT_TRUE(all.has_cycle()) << all.DebugString();
+    v1::Request one = CycleRequest(session, 2);
+    one.mutable_cycle()->mutable_outputs()->add_bands("NIR");
+    const v1::Reply nirOnly = daemon.Handle(one);
+    ASSERT_TRUE(nirOnly.has_cycle()) << nirOnly.DebugString();
+    ASSERT_EQ(nirOnly.cycle().organs(0).bands_size(), 1);
+    EXPECT_EQ(nirOnly.cycle().organs(0).bands(0).band(), "NIR");
+    ASSERT_EQ(nirOnly.cycle().statistics().balance_size(), 1);
+    // The shaded leaf's NIR: its refinement now weighs NIR power alone, so close, not equal.
+    const double full = all.cycle().organs(1).bands(1).irradiance_upper_wm2();
+    EXPECT_NEAR(nirOnly.cycle().organs(1).bands(0).irradiance_upper_wm2(), full, 0.05 * full);
+    one.mutable_cycle()->mutable_outputs()->add_bands("NIR");
+    EXPECT_EQ(daemon.Handle(one).error().code(), v1::ERROR_CODE_ALREADY_EXISTS);
+}
+
 // With a CurveZMQ secret key the daemon answers clients that know its public key, and
 // nobody else.
 TEST(DaemonCurve, AnswersOnlyClientsThatKnowItsKey) {
