@@ -10,11 +10,10 @@ Writes OUT_DIR/error.csv and OUT_DIR/error.png and prints the table.
 import argparse
 import csv
 import os
-import subprocess
 import sys
 
 from compare import errors, load
-from summary import solve
+from summary import generate_tree, solve
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -27,10 +26,8 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     rows = []
     for leaves in [int(n) for n in args.leaves.split(",")]:
-        scene = os.path.join(args.out, f"tree{leaves}.scene.txtpb")
         # Both solvers see the same 46-cone sky, so the error is the solver's alone.
-        subprocess.run([leaflux, "generate", "--leaves", str(leaves), "--seed", "2", "--sky-cones", "turtle46",
-                        "--out", scene], check=True, capture_output=True)
+        scene = generate_tree(leaflux, args.out, leaves, "turtle46")
         reference = os.path.join(args.out, f"tree{leaves}_reference.csv")
         if not os.path.exists(reference):  # the reference is cached: delete it to redo it
             solve(leaflux, scene, reference,

@@ -9,9 +9,8 @@ import argparse
 import csv
 import math
 import os
-import subprocess
 
-from summary import solve
+from summary import generate_tree, solve
 
 
 def slope(xs, ys):
@@ -32,9 +31,7 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     rows = []
     for leaves in [int(n) for n in args.leaves.split(",")]:
-        scene = os.path.join(args.out, f"tree{leaves}.scene.txtpb")
-        subprocess.run([leaflux, "generate", "--leaves", str(leaves), "--seed", "2", "--out", scene],
-                       check=True, capture_output=True)
+        scene = generate_tree(leaflux, args.out, leaves)
         for solver, options in (("hrc", ["--epsilon", args.epsilon]), ("mc", ["--samples", args.samples])):
             row = solve(leaflux, scene, os.path.join(args.out, f"tree{leaves}_{solver}.csv"),
                         ["--solver", solver] + options)

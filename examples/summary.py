@@ -1,4 +1,6 @@
-"""Runs `leaflux solve` and reads its one-line summary, for the benchmark scripts."""
+"""Runs `leaflux generate` and `leaflux solve` for the benchmark scripts, and reads the
+solve's one-line summary."""
+import os
 import re
 import subprocess
 
@@ -18,3 +20,11 @@ def solve(leaflux, scene, out, options):
     row["residual_pct"] = {band: float(r) for band, r in
                            re.findall(r"(\w+): incident [^;]*residual ([-0-9.e+]+) %", line)}
     return row
+
+
+def generate_tree(leaflux, out_dir, leaves, sky_cones="continuous"):
+    """Writes the benchmarks' generated tree of `leaves` leaves (seed 2); returns its path."""
+    scene = os.path.join(out_dir, f"tree{leaves}.scene.txtpb")
+    subprocess.run([leaflux, "generate", "--leaves", str(leaves), "--seed", "2", "--sky-cones", sky_cones,
+                    "--out", scene], check=True, capture_output=True)
+    return scene

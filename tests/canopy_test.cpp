@@ -117,10 +117,7 @@ TEST(RandomCanopy, ConservesEnergyWhenLeavesScatterNinetyNinePercent) {
     // Long paths make every estimate noisy; at 256 paths a leaf the balance is still known
     // to a few percent, so the check above can fail.
     EXPECT_LT(e.stderrW, 0.05 * e.incidentW);
-    for (const auto& light : solution.light) {
-        EXPECT_TRUE(std::isfinite(light[0].irradianceUpperWm2) &&
-                    std::isfinite(light[0].irradianceLowerWm2));
-    }
+    ExpectFiniteLight(solution);
 }
 
 TEST(Determinism, SameSeedSameResultWhateverTheThreads) {

@@ -153,11 +153,7 @@ TEST(HrcTree, StiffLeavesGiveAFiniteConvergedAnswer) {
     const PreparedScene prepared(scene);
     const Solution hrc = SolveWithHrc(prepared, 1e-4);
     EXPECT_LE(hrc.stats.residual, 1e-5);
-    for (const auto& light : hrc.light) {
-        EXPECT_TRUE(std::isfinite(light[0].irradianceUpperWm2) &&
-                    std::isfinite(light[0].irradianceLowerWm2));
-        EXPECT_GE(light[0].irradianceUpperWm2, 0.0);
-    }
+    ExpectFiniteLight(hrc);
 }
 
 // Extreme scenes: finite, converged, and within 5 % of the Monte Carlo reference on every
@@ -250,10 +246,7 @@ TEST(HrcExtreme, LampOneMillimetreBelowALeafIsFiniteAndConverged) {
     const PreparedScene prepared(scene);
     const Solution hrc = SolveWithHrc(prepared, 1e-6);
     EXPECT_LE(hrc.stats.residual, 1e-5);
-    for (const auto& light : hrc.light) {
-        EXPECT_TRUE(std::isfinite(light[0].irradianceUpperWm2) &&
-                    std::isfinite(light[0].irradianceLowerWm2));
-    }
+    ExpectFiniteLight(hrc);
     // The leaf cannot get more than the lamp emits (0.4 W on 0.01 m²) plus what it sends back.
     EXPECT_LT(hrc.light[0][0].irradianceLowerWm2, 2.0 * 40.0);
 }

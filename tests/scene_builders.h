@@ -1,11 +1,15 @@
 // Small scenes with known answers, shared by the tests.
 #pragma once
 
+#include <gtest/gtest.h>
+
+#include <cmath>
 #include <glm/gtc/constants.hpp>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "solver/light.h"
 #include "solver/scene.h"
 
 namespace leaflux::testing {
@@ -90,6 +94,16 @@ inline Scene Furnace(double rho, double exitance) {
              "wall"});
     }
     return scene;
+}
+
+// Every receiver's irradiance, each band and side, is a finite, non-negative number.
+inline void ExpectFiniteLight(const Solution& solution) {
+    for (const auto& bands : solution.light) {
+        for (const BandLight& light : bands) {
+            EXPECT_TRUE(std::isfinite(light.irradianceUpperWm2) && light.irradianceUpperWm2 >= 0.0);
+            EXPECT_TRUE(std::isfinite(light.irradianceLowerWm2) && light.irradianceLowerWm2 >= 0.0);
+        }
+    }
 }
 
 }  // namespace leaflux::testing
