@@ -63,6 +63,7 @@ SolverSettings SettingsFromProto(const v1::SolverSettings& in) {
     if (in.subdivision() > 0) settings.hrc.maxSubdivision = in.subdivision();
     settings.monteCarlo.seed = in.seed() == 0 ? 1 : in.seed();
     settings.monteCarlo.threads = settings.hrc.threads = in.threads();
+    settings.monteCarlo.directOnly = settings.hrc.directOnly = in.direct_only();
     return settings;
 }
 

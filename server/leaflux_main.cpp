@@ -27,7 +27,7 @@ struct SolveCommand {
     double epsilon = 1e-4;
     int subdivision = 3, visibilityRays = 8, directionLevel = 2;
     std::uint64_t seed = 1;
-    bool quiet = false;
+    bool directOnly = false, quiet = false;
 };
 
 int RunSolve(const SolveCommand& command) {
@@ -45,6 +45,7 @@ int RunSolve(const SolveCommand& command) {
     settings.hrc.maxSubdivision = command.subdivision;
     settings.hrc.visibilityRays = command.visibilityRays;
     settings.hrc.directionLevel = command.directionLevel;
+    settings.monteCarlo.directOnly = settings.hrc.directOnly = command.directOnly;
     if (!command.quiet) {
         spdlog::info(
             "{}: {} receivers, {} triangles, {} bands; loaded in {:.2f} s", command.scene,
@@ -126,7 +127,7 @@ int RunGenerate(const GenerateCommand& command) {
     if (!command.noSky) {
         scene.sources.skies.push_back({SkyModel::kCieOvercast,
                                        {command.skyPar, command.skyNir},
-                                       SkyDiscretization::kContinuous});
+                                       SkyDiscretizationNamed(command.skyCones)});
     }
     scene.Validate();
     SaveSceneFile(scene, command.out);
@@ -254,6 +255,8 @@ int main(int argc, char** argv) {
                      "mc: independent groups for the standard error")
         ->check(CLI::Range(2, 1024));
     solveApp->add_option("--seed", solve.seed, "mc: random seed (same seed, same result)");
+    solveApp->add_flag("--direct-only", solve.directOnly,
+                       "Light straight from the suns, the sky and the lamps only (no scattering)");
     solveApp->add_option("--threads", solve.threads, "Worker threads (0: every core)")
         ->check(CLI::Range(0, 1024));
     solveApp

@@ -412,6 +412,7 @@ class PathTracer {
                     if (depth == 0) direct[b] += emitted;
                 }
             }
+            if (options_.directOnly) return;
             // The radiance leaving the arriving side is (ρ I_arriving + τ I_other) / π,
             // with τ the transmittance from the other side: gather one side's irradiance,
             // chosen with Russian roulette.

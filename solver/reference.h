@@ -29,6 +29,9 @@ struct ReferenceOptions {
     int threads = 0;        // 0: every core
     int maxDepth = 100000;  // a safety net: with Russian roulette at ≤ 0.995,
                             // a path reaches it with probability < 1e-200
+    // Direct light only: light straight from the suns, the sky and the lamps; what leaves
+    // and surfaces scatter is dropped (and shows as missing in the energy balance).
+    bool directOnly = false;
     // Called with the fraction done, from any thread, at most every 1 %.
     std::function<void(double)> progress;
 };

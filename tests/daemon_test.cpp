@@ -556,7 +556,9 @@ TEST_F(DaemonOnLoopback, AnswersEveryBadRequestWithATypedErrorAndChangesNothing)
         EXPECT_EQ(reply.error().code(), bad.code) << reply.error().DebugString();
         EXPECT_NE(reply.error().field().find(bad.field), std::string::npos)
             << reply.error().DebugString();
-        if (bad.node != 0) EXPECT_EQ(reply.error().node(), bad.node);
+        if (bad.node != 0) {
+            EXPECT_EQ(reply.error().node(), bad.node);
+        }
         // The session is exactly as it was: two nodes, no cycle applied.
         v1::Request status;
         status.mutable_status()->set_session(session);

@@ -199,6 +199,31 @@ Scene TwoLeaves(double gap, glm::dvec3 offset) {
     return scene;
 }
 
+// Direct light only: the sun's light arrives, what the leaves scatter does not. The top
+// leaf's upper side sees the sun alone either way; its lower side gets only what the
+// bottom leaf reflects, and the bottom leaf's shaded part only what the top one transmits.
+TEST(DirectOnly, DropsScatteredLightInBothSolvers) {
+    Scene scene = TwoLeaves(0.02, glm::dvec3(0.0));
+    scene.sources.suns.push_back(SunAt(90, 0, 1000));
+    scene.Validate();
+    const PreparedScene prepared(scene);
+    for (const SolverKind kind : {SolverKind::kMonteCarlo, SolverKind::kHrc}) {
+        SolverSettings settings;
+        settings.kind = kind;
+        settings.monteCarlo.samplesPerReceiver = 256;
+        settings.hrc.epsilon = 1e-5;
+        const Solution full = Solve(prepared, settings);
+        settings.monteCarlo.directOnly = settings.hrc.directOnly = true;
+        const Solution direct = Solve(prepared, settings);
+        SCOPED_TRACE(kind == SolverKind::kHrc ? "hrc" : "mc");
+        EXPECT_NEAR(direct.light[0][0].irradianceUpperWm2, 1000.0, 1e-6);
+        EXPECT_EQ(direct.light[0][0].irradianceLowerWm2, 0.0);
+        EXPECT_GT(full.light[0][0].irradianceLowerWm2, 10.0);
+        EXPECT_GT(full.light[1][0].irradianceUpperWm2,
+                  direct.light[1][0].irradianceUpperWm2 + 100.0);
+    }
+}
+
 TEST(Hrc, RefusesPeriodicDomainsWithATypedError) {
     Scene scene = TwoLeaves(0.02, glm::dvec3(0.0));
     scene.periodic = PeriodicDomain{-1, -1, 1, 1};

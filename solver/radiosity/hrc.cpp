@@ -808,13 +808,20 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
 
     Stopwatch clock;
     for (std::uint32_t s = 0; s < sources_.size(); ++s) RefineSource(hierarchy_.Root(), s);
-    // Direct light first, so that links are refined on what senders will send.
+    // Direct light first, so that links are refined on what senders will send; with
+    // direct light only, lamps are the only senders and their links the only ones needed.
     Index();
-    PushDown(true);
-    UpdateRadiosity();
+    if (!options_.directOnly) {
+        PushDown(true);
+        UpdateRadiosity();
+    }
     PullUp();
     const double sourceSeconds = clock.Lap();
-    RefineSelf(hierarchy_.Root());
+    const bool lamps = std::any_of(preOrder_.begin(), preOrder_.end(), [&](std::uint32_t n) {
+        return std::any_of(emission_[n].begin(), emission_[n].begin() + bands_,
+                           [](double e) { return e > 0.0; });
+    });
+    if (!options_.directOnly || lamps) RefineSelf(hierarchy_.Root());
     Index();
     const double refineSeconds = clock.Lap();
 
@@ -823,7 +830,8 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
     PullUp();
     double residual = 0.0;
     int iteration = 0;
-    for (; iteration < options_.maxIterations; ++iteration) {
+    const int iterations = options_.directOnly ? 1 : options_.maxIterations;
+    for (; iteration < iterations; ++iteration) {
         Gather();
         PushDown(false);
         if (iteration == 0) direct_ = irradiance_;

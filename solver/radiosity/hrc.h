@@ -32,6 +32,9 @@ struct HrcOptions {
     double tolerance = 1e-5;  // iteration stops when the radiosity changes less than
                               // this times its maximum
     int maxIterations = 2000;
+    // Direct light only: one gathering sweep from the sources and lamps, no links for
+    // light scattered by leaves and surfaces (it shows as missing in the energy balance).
+    bool directOnly = false;
     int threads = 0;  // 0: every core
     // A continuous sky is discretised into these cones for the hierarchy's links.
     SkyDiscretization skyCones = SkyDiscretization::kTurtle46;
