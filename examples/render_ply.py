@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
-"""Renders a leaflux PLY (from `leaflux solve --ply`) to a PNG: a side and a top view,
-each triangle coloured by the irradiance on the side facing the viewer's sky (upper)."""
+"""Renders a leaflux PLY (from `leaflux solve --ply` or `leaflux-grow`) to a PNG: a side and
+a top view, each triangle coloured by its irradiance, both sides summed. Faces whose light
+is negative (walls, ground, lamps written by leaflux-grow) are drawn as grey glass in the
+side view only."""
 import sys
 
 import matplotlib
@@ -29,35 +31,46 @@ def read_ply(path):
     return xyz, triangles, upper, lower
 
 
-def main(ply, png):
+def main(ply, png, title=None):
     xyz, triangles, upper, lower = read_ply(ply)
     total = upper + lower
-    # Leave the ground out of the picture when it spans far beyond the plant.
     polygons = xyz[triangles]
-    extent = polygons.max(axis=1) - polygons.min(axis=1)
-    keep = extent.max(axis=1) < 0.5 * (xyz.max(axis=0) - xyz.min(axis=0)).max()
-    norm = matplotlib.colors.Normalize(vmin=0, vmax=np.percentile(total[keep], 99))
+    scenery = upper < 0
+    if scenery.any():
+        keep = ~scenery
+    else:  # leave the ground out of the picture when it spans far beyond the plant
+        extent = polygons.max(axis=1) - polygons.min(axis=1)
+        keep = extent.max(axis=1) < 0.5 * (xyz.max(axis=0) - xyz.min(axis=0)).max()
+    norm = matplotlib.colors.Normalize(vmin=0, vmax=max(np.percentile(total[keep], 99), 1e-9))
     colours = plt.cm.viridis(norm(total[keep]))
     fig = plt.figure(figsize=(12, 6))
-    fig.subplots_adjust(left=0, right=0.9, bottom=0, top=0.95, wspace=0)
-    for i, (elevation, azimuth, title) in enumerate([(5, -60, "side"), (89, -90, "top")]):
+    fig.subplots_adjust(left=0, right=0.9, bottom=0, top=0.92, wspace=0)
+    if title:
+        fig.suptitle(title)
+    for i, (elevation, azimuth, view) in enumerate([(5, -60, "side"), (89, -90, "top")]):
         ax = fig.add_subplot(1, 2, i + 1, projection="3d")
+        framed = polygons[keep]
+        if view == "side" and scenery.any():
+            ax.add_collection3d(Poly3DCollection(polygons[scenery], facecolors=(0.5, 0.5, 0.5, 0.06),
+                                                 edgecolors=(0.3, 0.3, 0.3, 0.4), linewidths=0.5))
+            framed = polygons
         ax.add_collection3d(Poly3DCollection(polygons[keep], facecolors=colours, linewidths=0))
-        lo, hi = polygons[keep].reshape(-1, 3).min(axis=0), polygons[keep].reshape(-1, 3).max(axis=0)
+        lo, hi = framed.reshape(-1, 3).min(axis=0), framed.reshape(-1, 3).max(axis=0)
         centre, half = (lo + hi) / 2, (hi - lo).max() / 2
         ax.set_xlim(centre[0] - half, centre[0] + half)
         ax.set_ylim(centre[1] - half, centre[1] + half)
         ax.set_zlim(centre[2] - half, centre[2] + half)
-        ax.set_box_aspect((1, 1, 1), zoom=1.3)
+        ax.set_box_aspect((1, 1, 1), zoom=1.0 if framed is polygons else 1.3)
         ax.view_init(elev=elevation, azim=azimuth)
-        ax.set_title(f"{title} view")
+        ax.set_title(f"{view} view")
         ax.set_axis_off()
     mappable = plt.cm.ScalarMappable(norm=norm, cmap="viridis")
     fig.colorbar(mappable, ax=fig.axes, shrink=0.6, label="irradiance, both sides (W/m², first band)")
     fig.savefig(png, dpi=110)
+    plt.close(fig)
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
-        sys.exit("usage: render_ply.py IN.ply OUT.png")
-    main(sys.argv[1], sys.argv[2])
+    if len(sys.argv) not in (3, 4):
+        sys.exit("usage: render_ply.py IN.ply OUT.png [TITLE]")
+    main(*sys.argv[1:])

@@ -11,8 +11,8 @@
 #include <iostream>
 #include <sstream>
 
+#include "server/client.h"
 #include "server/scene_proto.h"
-#include "server/transport.h"
 #include "solver/error.h"
 #include "solver/export.h"
 #include "solver/generator.h"
@@ -148,8 +148,7 @@ struct ClientCommand {
 };
 
 // Sends one request to leafluxd and prints the reply in protobuf text format.
-int RunClient(const ClientCommand& command, v1::Request request) {
-    request.set_version(v1::PROTOCOL_VERSION_CURRENT);
+int RunClient(const ClientCommand& command, const v1::Request& request) {
     std::string serverKey;
     if (!command.curveServerKeyFile.empty()) {
         std::ifstream in(command.curveServerKeyFile);
@@ -159,17 +158,12 @@ int RunClient(const ClientCommand& command, v1::Request request) {
                              "not a Z85 CurveZMQ public key");
         }
     }
-    zmq::context_t context;
-    ClientConnection connection(context, command.endpoint, serverKey);
-    std::string bytes, answer;
-    request.SerializeToString(&bytes);
-    if (!connection.Call(bytes, answer, command.timeoutS * 1000)) {
-        spdlog::error("no reply from {} within {} s", command.endpoint, command.timeoutS);
-        return 4;
-    }
+    Client client(command.endpoint, serverKey, command.timeoutS * 1000);
     v1::Reply reply;
-    if (!reply.ParseFromString(answer)) {
-        spdlog::error("the reply is not a leaflux.v1.Reply");
+    try {
+        reply = client.Call(request);
+    } catch (const ClientError& e) {
+        spdlog::error("{}: {}", command.endpoint, e.what());
         return 4;
     }
     std::string text;

@@ -1,6 +1,5 @@
 #include "server/scene_proto.h"
 
-#include <google/protobuf/io/tokenizer.h>
 #include <google/protobuf/text_format.h>
 
 #include <cmath>
@@ -9,6 +8,7 @@
 #include <map>
 #include <sstream>
 
+#include "server/text_format.h"
 #include "solver/error.h"
 #include "solver/importers.h"
 
@@ -441,35 +441,11 @@ v1::Scene ToProto(const Scene& scene) {
     return message;
 }
 
-namespace {
-class CollectErrors : public google::protobuf::io::ErrorCollector {
-  public:
-    void AddError(int line, google::protobuf::io::ColumnNumber column,
-                  const std::string& message) override {
-        if (first_.empty())
-            first_ = std::to_string(line + 1) + ":" + std::to_string(column + 1) + ": " + message;
-    }
-    const std::string& First() const { return first_; }
-
-  private:
-    std::string first_;
-};
-}  // namespace
-
 Scene LoadSceneFile(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) Fail(ErrorCode::kIo, path, "cannot open the scene file");
-    std::stringstream text;
-    text << in.rdbuf();
     v1::Scene message;
-    google::protobuf::TextFormat::Parser parser;
-    CollectErrors errors;
-    parser.RecordErrorsTo(&errors);
-    if (!parser.ParseFromString(text.str(), &message)) {
-        const std::string& first = errors.First();
-        const auto colon = first.find(": ");
-        Fail(ErrorCode::kParse, path + ":" + first.substr(0, colon),
-             colon == std::string::npos ? first : first.substr(colon + 2));
+    if (const auto error = ReadTextFormat(path, message)) {
+        Fail(error->unreadable ? ErrorCode::kIo : ErrorCode::kParse, error->where,
+             error->unreadable ? "cannot open the scene file" : error->what);
     }
     return FromProto(message, std::filesystem::path(path).parent_path().string());
 }

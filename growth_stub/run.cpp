@@ -1,0 +1,243 @@
+#include "growth_stub/run.h"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "server/text_format.h"
+
+namespace leaflux::grow {
+namespace {
+
+// The session's scene: the scenario's (bands, optics, environment, sources), the model's
+// shared meshes and room, and the given nodes.
+v1::Scene SessionScene(const Scenario& scenario, const GrowthModel& model,
+                       const std::map<NodeId, v1::Node>& nodes) {
+    v1::Scene scene = scenario.scene();
+    scene.set_version(leaflux::v1::PROTOCOL_VERSION_CURRENT);
+    for (const auto& [name, mesh] : GrowthModel::Meshes()) (*scene.mutable_meshes())[name] = mesh;
+    for (const v1::Surface& surface : model.Environment()) *scene.add_environment() = surface;
+    for (const auto& [id, node] : nodes) *scene.add_nodes() = node;
+    return scene;
+}
+
+const v1::BandLight* BandOf(const google::protobuf::RepeatedPtrField<v1::BandLight>& bands,
+                            const std::string& band) {
+    for (const v1::BandLight& b : bands) {
+        if (b.band() == band) return &b;
+    }
+    return nullptr;
+}
+
+LeafLight FromBand(const v1::BandLight& b) {
+    return {b.absorbed_w(), b.irradiance_upper_wm2() + b.irradiance_lower_wm2(),
+            {b.light_vector().x(), b.light_vector().y(), b.light_vector().z()}};
+}
+
+// The PAR of every leaf: its own, or with branch-level light its axis's mean irradiance
+// and light vector, and its axis's absorbed power per m² times its area (stems included:
+// a coarser answer, for models that only need it).
+std::map<NodeId, LeafLight> LeafLightOf(const v1::CycleResult& result, const GrowthModel& model,
+                                        const std::string& band, bool branchLight) {
+    std::unordered_map<NodeId, LeafLight> byNode;
+    if (branchLight) {
+        for (const v1::StructureLight& s : result.structures()) {
+            const v1::BandLight* b = BandOf(s.bands(), band);
+            if (s.type() != v1::NODE_TYPE_AXIS || !b || s.area_m2() <= 0.0) continue;
+            LeafLight perM2 = FromBand(*b);
+            perM2.absorbedW /= s.area_m2();
+            byNode[s.node()] = perM2;
+        }
+    } else {
+        for (const v1::OrganLight& organ : result.organs()) {
+            if (const v1::BandLight* b = BandOf(organ.bands(), band)) byNode[organ.node()] = FromBand(*b);
+        }
+    }
+    std::map<NodeId, LeafLight> light;
+    for (const GrowthModel::LeafInfo& leaf : model.Leaves()) {
+        const auto it = byNode.find(branchLight ? leaf.axis : leaf.leaf);
+        if (it == byNode.end()) {
+            throw std::runtime_error("cycle " + std::to_string(result.number()) + ": leaf " +
+                                     std::to_string(leaf.leaf) + " got no light");
+        }
+        light[leaf.leaf] = it->second;
+        if (branchLight) light[leaf.leaf].absorbedW *= leaf.areaM2;
+    }
+    return light;
+}
+
+// Every plant triangle with the PAR irradiance of its organ (upper, lower), and the
+// scene's surfaces and lamps with −1 (drawn grey).
+void WritePly(const std::string& path, const Scenario& scenario, const GrowthModel& model,
+              const std::map<NodeId, LeafLight>& light, const v1::CycleResult& result) {
+    struct Face {
+        glm::dvec3 p[3];
+        double upper, lower;
+    };
+    std::unordered_map<NodeId, std::pair<double, double>> organLight;
+    for (const v1::OrganLight& organ : result.organs()) {
+        if (const v1::BandLight* b = BandOf(organ.bands(), scenario.par_band())) {
+            organLight[organ.node()] = {b->irradiance_upper_wm2(), b->irradiance_lower_wm2()};
+        }
+    }
+    std::vector<Face> faces;
+    for (const WorldTriangle& t : model.Triangles()) {
+        std::pair<double, double> e{-1.0, -1.0};
+        if (const auto it = organLight.find(t.organ); it != organLight.end()) {
+            e = it->second;
+        } else if (const auto leaf = light.find(t.organ); leaf != light.end()) {
+            e = {leaf->second.irradianceWm2, 0.0};
+        }
+        faces.push_back({{t.a, t.b, t.c}, e.first, e.second});
+    }
+    const auto addMesh = [&](const v1::Mesh& mesh) {
+        const auto vertex = [&](std::uint32_t i) {
+            return glm::dvec3(mesh.positions(3 * i), mesh.positions(3 * i + 1),
+                              mesh.positions(3 * i + 2));
+        };
+        for (int t = 0; t + 2 < mesh.triangles_size(); t += 3) {
+            faces.push_back({{vertex(mesh.triangles(t)), vertex(mesh.triangles(t + 1)),
+                              vertex(mesh.triangles(t + 2))},
+                             -1.0,
+                             -1.0});
+        }
+    };
+    for (const v1::Surface& s : scenario.scene().environment()) addMesh(s.mesh());
+    for (const v1::Surface& s : model.Environment()) addMesh(s.mesh());
+    for (const v1::Emitter& e : scenario.scene().emitters()) addMesh(e.mesh());
+
+    std::ofstream out(path);
+    out << "ply\nformat ascii 1.0\ncomment leaflux-grow: PAR irradiance per face, -1: not a "
+           "plant\nelement vertex "
+        << 3 * faces.size()
+        << "\nproperty double x\nproperty double y\nproperty double z\nelement face "
+        << faces.size()
+        << "\nproperty list uchar int vertex_indices\nproperty double irradiance_upper\n"
+           "property double irradiance_lower\nend_header\n";
+    for (const Face& f : faces) {
+        for (const glm::dvec3& p : f.p) out << p.x << ' ' << p.y << ' ' << p.z << '\n';
+    }
+    for (std::size_t i = 0; i < faces.size(); ++i) {
+        out << "3 " << 3 * i << ' ' << 3 * i + 1 << ' ' << 3 * i + 2 << ' ' << faces[i].upper
+            << ' ' << faces[i].lower << '\n';
+    }
+    if (!out) throw std::runtime_error(path + ": cannot write");
+}
+
+}  // namespace
+
+Scenario LoadScenario(const std::string& path) {
+    Scenario scenario;
+    if (const auto error = ReadTextFormat(path, scenario)) {
+        throw std::invalid_argument(error->where + ": " + error->what);
+    }
+    return scenario;
+}
+
+std::vector<CycleRecord> Run(const Scenario& scenario, const RunOptions& options,
+                             Client& client) {
+    GrowthModel model(scenario);
+    v1::OpenSession open;
+    *open.mutable_scene() = SessionScene(scenario, model, {});
+    *open.mutable_settings() = scenario.settings();
+    open.set_species(scenario.name());
+    const std::string session = client.Open(open);
+
+    std::ofstream cyclesCsv, plantsCsv;
+    if (!options.outDir.empty()) {
+        std::filesystem::create_directories(options.outDir);
+        cyclesCsv.open(options.outDir + "/cycles.csv");
+        plantsCsv.open(options.outDir + "/plants.csv");
+        cyclesCsv << "cycle,leaves,leaf_area_m2,biomass_g,absorbed_par_w,added,updated,removed,"
+                     "solve_s,round_trip_s,daemon_peak_mib\n";
+        plantsCsv << "cycle,plant,leaves,leaf_area_m2,biomass_g,absorbed_par_w,centroid_x,"
+                     "centroid_y,centroid_z\n";
+    }
+    std::vector<CycleRecord> records;
+    std::map<NodeId, v1::Node> sent;
+    for (int c = 1; c <= options.cycles; ++c) {
+        const std::map<NodeId, v1::Node> nodes = model.Nodes();
+        v1::Cycle cycle;
+        cycle.set_session(session);
+        cycle.set_number(c);
+        *cycle.mutable_delta() = Diff(sent, nodes);
+        cycle.mutable_outputs()->set_leaves(!options.branchLight);
+        cycle.mutable_outputs()->set_structures(options.branchLight);
+        cycle.mutable_outputs()->add_bands(scenario.par_band());
+
+        const auto start = std::chrono::steady_clock::now();
+        v1::CycleResult result;
+        try {
+            result = client.Cycle(cycle);
+        } catch (const ClientError& e) {
+            if (e.Error().code() != v1::ERROR_CODE_UNKNOWN_SESSION) throw;
+            // The daemon restarted: give it the scene as it was, then the cycle again.
+            v1::Resync resync;
+            resync.set_session(session);
+            *resync.mutable_scene() = SessionScene(scenario, model, sent);
+            *resync.mutable_settings() = scenario.settings();
+            client.Resync(resync);
+            result = client.Cycle(cycle);
+        }
+        sent = nodes;
+        const std::map<NodeId, LeafLight> light =
+            LeafLightOf(result, model, scenario.par_band(), options.branchLight);
+
+        CycleRecord record;
+        record.cycle = c;
+        record.added = cycle.delta().added_size();
+        record.updated = cycle.delta().updated_size();
+        record.removed = cycle.delta().removed_size();
+        record.roundTripSeconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        record.solveSeconds = result.statistics().wall_seconds();
+        record.daemonPeakMib = result.statistics().peak_rss_bytes() / 1048576.0;
+        // The rows and pictures tell the plants as they were lit; then they grow.
+        record.plants = model.Summaries();
+        std::map<NodeId, PlantSummary*> byPlant;
+        for (PlantSummary& plant : record.plants) byPlant[plant.id] = &plant;
+        for (const GrowthModel::LeafInfo& leaf : model.Leaves()) {
+            byPlant.at(leaf.plant)->absorbedParW += light.at(leaf.leaf).absorbedW;
+        }
+        for (const PlantSummary& plant : record.plants) {
+            record.leaves += plant.leaves;
+            record.leafAreaM2 += plant.leafAreaM2;
+            record.biomassG += plant.biomassG;
+            record.absorbedParW += plant.absorbedParW;
+        }
+        if (!options.outDir.empty()) {
+            cyclesCsv << c << ',' << record.leaves << ',' << record.leafAreaM2 << ','
+                      << record.biomassG << ',' << record.absorbedParW << ',' << record.added
+                      << ',' << record.updated << ',' << record.removed << ','
+                      << record.solveSeconds << ',' << record.roundTripSeconds << ','
+                      << record.daemonPeakMib << '\n';
+            for (const PlantSummary& plant : record.plants) {
+                plantsCsv << c << ',' << plant.id << ',' << plant.leaves << ',' << plant.leafAreaM2
+                          << ',' << plant.biomassG << ',' << plant.absorbedParW << ','
+                          << plant.leafCentroid.x << ',' << plant.leafCentroid.y << ','
+                          << plant.leafCentroid.z << '\n';
+            }
+            if (options.plyCycles.count(c)) {
+                WritePly(options.outDir + "/cycle" + std::to_string(c) + ".ply", scenario, model,
+                         light, result);
+            }
+        }
+        if (!options.quiet) {
+            std::printf("cycle %3d: %5d leaves, %7.4f m², %8.3f g, PAR absorbed %8.3f W; "
+                        "+%d ~%d -%d nodes; solve %.3f s, round trip %.3f s, daemon %.0f MiB\n",
+                        c, record.leaves, record.leafAreaM2, record.biomassG, record.absorbedParW,
+                        record.added, record.updated, record.removed, record.solveSeconds,
+                        record.roundTripSeconds, record.daemonPeakMib);
+            std::fflush(stdout);
+        }
+        model.Grow(light);
+        records.push_back(record);
+    }
+    client.Close(session);
+    return records;
+}
+
+}  // namespace leaflux::grow

@@ -1,0 +1,42 @@
+// leaflux-grow's cycle loop: the growth model on one side, leafluxd on the other, and only
+// the protocol between them. Each cycle sends the delta of the plants, reads the light,
+// writes the cycle's rows and, at chosen cycles, a PLY of the plants with their light.
+#pragma once
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include "growth_stub/model.h"
+#include "server/client.h"
+
+namespace leaflux::grow {
+
+struct RunOptions {
+    int cycles = 25;
+    std::string outDir;           // cycles.csv, plants.csv, cycle<N>.ply; "" writes nothing
+    std::set<int> plyCycles;      // cycles whose geometry and light are written
+    bool branchLight = false;     // ask for per-axis light only, not per leaf
+    bool quiet = false;
+};
+
+// One cycle, after the daemon lit it.
+struct CycleRecord {
+    int cycle = 0;
+    int leaves = 0;
+    double leafAreaM2 = 0.0, biomassG = 0.0, absorbedParW = 0.0;
+    int added = 0, updated = 0, removed = 0;
+    double solveSeconds = 0.0, roundTripSeconds = 0.0, daemonPeakMib = 0.0;
+    std::vector<PlantSummary> plants;
+};
+
+// Opens a session for the scenario (settings as in it), runs the cycles and closes the
+// session. A daemon that lost the session (restarted) gets a Resync and the cycle again.
+// Throws ClientError for a rejected request, std::runtime_error when a leaf got no light.
+std::vector<CycleRecord> Run(const Scenario& scenario, const RunOptions& options,
+                             Client& client);
+
+// Reads a scenario file (protobuf text format); errors name the file, line and column.
+Scenario LoadScenario(const std::string& path);
+
+}  // namespace leaflux::grow
