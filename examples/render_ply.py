@@ -38,6 +38,10 @@ def main(ply, png, title=None):
     scenery = upper < 0
     if scenery.any():
         keep = ~scenery
+        # Scenery far larger than the plants (an open ground) is left out.
+        plant = polygons[keep].reshape(-1, 3)
+        size = (plant.max(axis=0) - plant.min(axis=0)).max()
+        scenery &= (polygons.max(axis=1) - polygons.min(axis=1)).max(axis=1) < 5 * size
     else:  # leave the ground out of the picture when it spans far beyond the plant
         extent = polygons.max(axis=1) - polygons.min(axis=1)
         keep = extent.max(axis=1) < 0.5 * (xyz.max(axis=0) - xyz.min(axis=0)).max()

@@ -1,6 +1,7 @@
 // leaflux-grow: grows the plants of a scenario for a number of cycles, lit by leafluxd.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <fstream>
 #include <sstream>
 
 #include "growth_stub/run.h"
@@ -61,7 +62,8 @@ int main(int argc, char** argv) {
             in >> serverKey;
         }
         Client client(endpoint, serverKey);
-        const auto records = grow::Run(scenario, options, client);
+        grow::GrowthModel model(scenario);
+        const auto records = grow::Run(scenario, model, options, client);
         const grow::CycleRecord& last = records.back();
         std::printf("%s: %d cycles, %d leaves, %.4f m² of leaves, %.3f g of biomass\n",
                     scenario.name().c_str(), last.cycle, last.leaves, last.leafAreaM2,

@@ -137,9 +137,8 @@ Scenario LoadScenario(const std::string& path) {
     return scenario;
 }
 
-std::vector<CycleRecord> Run(const Scenario& scenario, const RunOptions& options,
-                             Client& client) {
-    GrowthModel model(scenario);
+std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
+                             const RunOptions& options, Client& client) {
     v1::OpenSession open;
     *open.mutable_scene() = SessionScene(scenario, model, {});
     *open.mutable_settings() = scenario.settings();

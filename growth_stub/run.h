@@ -33,8 +33,9 @@ struct CycleRecord {
 // Opens a session for the scenario (settings as in it), runs the cycles and closes the
 // session. A daemon that lost the session (restarted) gets a Resync and the cycle again.
 // Throws ClientError for a rejected request, std::runtime_error when a leaf got no light.
-std::vector<CycleRecord> Run(const Scenario& scenario, const RunOptions& options,
-                             Client& client);
+// `model` grows in place (built from `scenario`, it may be inspected afterwards).
+std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
+                             const RunOptions& options, Client& client);
 
 // Reads a scenario file (protobuf text format); errors name the file, line and column.
 Scenario LoadScenario(const std::string& path);

@@ -10,52 +10,10 @@
 #include <limits>
 #include <thread>
 
-#include "server/executor.h"
-#include "server/transport.h"
+#include "tests/daemon_fixture.h"
 
 namespace leaflux {
 namespace {
-
-class DaemonOnLoopback : public ::testing::Test {
-  protected:
-    void SetUp() override {
-        TransportLimits limits;
-        limits.maxBytes = 1 << 20;  // small, so that an oversized message is cheap to send
-        server_ = std::make_unique<RouterServer>(context_, "tcp://127.0.0.1:*", limits);
-        thread_ = std::thread([this] {
-            server_->Serve(
-                DaemonDispatch(daemon_, executor_),
-                [] {
-                    std::string out;
-                    ErrorReply(v1::ERROR_CODE_TOO_LARGE, "too large").SerializeToString(&out);
-                    return out;
-                },
-                [this] { return daemon_.ShutdownRequested(); }, stop_);
-        });
-        client_ = std::make_unique<ClientConnection>(context_, server_->Endpoint());
-    }
-    void TearDown() override {
-        stop_ = true;
-        thread_.join();
-    }
-
-    v1::Reply Call(const v1::Request& request) {
-        std::string bytes, reply;
-        request.SerializeToString(&bytes);
-        EXPECT_TRUE(client_->Call(bytes, reply, 60000));
-        v1::Reply decoded;
-        EXPECT_TRUE(decoded.ParseFromString(reply));
-        return decoded;
-    }
-
-    zmq::context_t context_;
-    Daemon daemon_;
-    KeyedExecutor executor_{2};
-    std::unique_ptr<RouterServer> server_;
-    std::unique_ptr<ClientConnection> client_;
-    std::atomic<bool> stop_{false};
-    std::thread thread_;
-};
 
 v1::Node Leaf(std::uint64_t id, std::uint64_t parent, double x, double z = 1.0) {
     v1::Node node;
