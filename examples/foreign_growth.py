@@ -1,0 +1,97 @@
+#!/usr/bin/env python3
+"""Coupling a foreign growth model to leafluxd: a rosette written in a few lines of Python
+sends its own deltas and grows from the light it gets back.
+
+Each cycle the rosette makes a new leaf (a flat blade at the golden angle, raised 20°) and
+every leaf grows in proportion to the PAR it absorbed: only the new leaf is added and
+only the leaves that grew are updated (their frame's scale changes).
+
+Usage: foreign_growth.py [--endpoint tcp://…] [--cycles 12]   (no endpoint: starts leafluxd)
+"""
+import argparse
+import math
+
+from leaflux_client import Client, LocalDaemon, band_light, frame, pb
+
+RUE_G_PER_MJ, LIGHT_HOURS, SLA_M2_PER_G = 2.5, 8.0, 0.03
+
+
+def scene():
+    s = pb.Scene(version=pb.PROTOCOL_VERSION_CURRENT)
+    s.bands.add(name="PAR", wavelength_min_nm=400, wavelength_max_nm=700)
+    leaf = s.optics.add(id="leaf")
+    leaf.bands["PAR"].CopyFrom(pb.BandOptics(rho_upper=0.1, rho_lower=0.1, tau_upper=0.05, tau_lower=0.05))
+    ground = s.optics.add(id="ground")
+    ground.bands["PAR"].CopyFrom(pb.BandOptics(rho_upper=0.1, rho_lower=0.1))
+    # A unit blade from the origin along +x, upper side up; frames scale it.
+    s.meshes["blade"].positions.extend([0, 0, 0, 0.5, -0.25, 0, 1, 0, 0, 0.5, 0.25, 0])
+    s.meshes["blade"].triangles.extend([0, 1, 2, 0, 2, 3])
+    g = s.environment.add(name="ground", optics="ground")
+    g.mesh.positions.extend([-2, -2, 0, 2, -2, 0, 2, 2, 0, -2, 2, 0])
+    g.mesh.triangles.extend([0, 1, 2, 0, 2, 3])
+    sun = s.suns.add()
+    sun.direction.x, sun.direction.y, sun.direction.z = 0.3, 0.4, 0.866
+    sun.normal_irradiance["PAR"] = 400
+    s.sky.model = pb.SKY_MODEL_CIE_OVERCAST
+    s.sky.horizontal_irradiance["PAR"] = 80
+    s.sky.discretization = pb.SKY_DISCRETIZATION_TURTLE_46
+    s.nodes.add(id=1, parent=0, type=pb.NODE_TYPE_PLANT, name="rosette")
+    return s
+
+
+def leaf_node(index, area_m2):
+    """Leaf `index` of the rosette: at the golden angle, raised 20°, scaled to its area."""
+    azimuth, raise_ = math.radians(137.5 * index), math.radians(20)
+    length = math.sqrt(area_m2 / 0.25)  # the unit blade has an area of 0.25 and width / length 0.5
+    ca, sa, cr, sr = math.cos(azimuth), math.sin(azimuth), math.cos(raise_), math.sin(raise_)
+    # Rz(azimuth) · Ry(−raise) · S(length, length, 1), 1 cm above the ground.
+    m = [[ca * cr * length, -sa * length, -ca * sr, 0.0],
+         [sa * cr * length, ca * length, -sa * sr, 0.0],
+         [sr * length, 0.0, cr, 0.01 + 0.002 * index]]
+    node = pb.Node(id=100 + index, parent=1, type=pb.NODE_TYPE_LEAF, name=f"leaf{index}")
+    node.frame.CopyFrom(frame(m))
+    node.organ.mesh_ref, node.organ.optics = "blade", "leaf"
+    return node
+
+
+def grow(client, cycles):
+    session = client.open(scene(), pb.SolverSettings(solver=pb.SOLVER_KIND_HRC, epsilon=1e-4), "rosette")
+    areas = []  # m², per leaf
+    new, changed = [], []
+    print(f"{'cycle':>5} {'leaves':>6} {'area_m2':>8} {'absorbed_W':>10} {'biomass_g':>9} {'sent':>5}")
+    biomass = 0.0
+    for number in range(1, cycles + 1):
+        areas.append(0.002)  # a new leaf each cycle
+        new = [leaf_node(len(areas) - 1, areas[-1])]
+        result = client.cycle(session, number, added=new, updated=changed, bands=["PAR"])
+        absorbed = {o.node: band_light(o, "PAR").absorbed_w for o in result.organs if o.node >= 100}
+        assert len(absorbed) == len(areas), "every leaf gets its light"
+        total = sum(absorbed.values())
+        produced = RUE_G_PER_MJ * total * LIGHT_HOURS * 3600 * 1e-6
+        biomass += produced
+        # The new biomass goes to the leaves in proportion to what each absorbed.
+        changed = []
+        for node, watts in absorbed.items():
+            if watts > 0:
+                areas[node - 100] += SLA_M2_PER_G * produced * watts / total
+                changed.append(leaf_node(node - 100, areas[node - 100]))
+        print(f"{number:>5} {len(areas):>6} {sum(areas):>8.4f} {total:>10.3f} {biomass:>9.3f} "
+              f"{len(new) + len(changed):>5}")
+    client.close(session)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--endpoint")
+    parser.add_argument("--cycles", type=int, default=12)
+    args = parser.parse_args()
+    if args.endpoint:
+        with Client(args.endpoint) as client:
+            grow(client, args.cycles)
+    else:
+        with LocalDaemon() as daemon, Client(daemon.endpoint) as client:
+            grow(client, args.cycles)
+
+
+if __name__ == "__main__":
+    main()
