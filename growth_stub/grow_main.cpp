@@ -28,7 +28,8 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     app.add_option("--solver", solver, "Override the scenario's solver: hrc or mc")
         ->check(CLI::IsMember({"hrc", "mc"}));
-    app.add_option("--epsilon", epsilon, "Override the scenario's HRC ε")->check(CLI::Range(1e-9, 1.0));
+    app.add_option("--epsilon", epsilon, "Override the scenario's HRC ε")
+        ->check(CLI::Range(1e-9, 1.0));
     app.add_option("--samples", samples, "Override the scenario's MC paths per receiver")
         ->check(CLI::Range(2, 1 << 24));
     app.add_flag("--direct-only", directOnly,
@@ -46,7 +47,8 @@ int main(int argc, char** argv) {
         grow::Scenario scenario = grow::LoadScenario(scenarioPath);
         options.cycles = cycles > 0 ? cycles : (scenario.cycles() > 0 ? scenario.cycles() : 25);
         std::stringstream list(pictures);
-        for (std::string item; std::getline(list, item, ',');) options.plyCycles.insert(std::stoi(item));
+        for (std::string item; std::getline(list, item, ',');)
+            options.plyCycles.insert(std::stoi(item));
         v1::SolverSettings& settings = *scenario.mutable_settings();
         if (solver == "hrc") settings.set_solver(v1::SOLVER_KIND_HRC);
         if (solver == "mc") settings.set_solver(v1::SOLVER_KIND_MONTE_CARLO);

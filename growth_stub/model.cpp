@@ -4,12 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/gtc/constants.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <stdexcept>
 #include <string>
-
-#include <glm/gtc/constants.hpp>
-#include <glm/gtc/matrix_transform.hpp>
 
 namespace leaflux::grow {
 namespace {
@@ -56,9 +55,8 @@ std::vector<Placement> Placements(const Scenario& scenario) {
         const glm::dvec2 along(std::sin(a), std::cos(a)), across(std::cos(a), -std::sin(a));
         for (int r = 0; r < stand.rows(); ++r) {
             for (int i = 0; i < stand.per_row(); ++i) {
-                const glm::dvec2 p =
-                    (r - 0.5 * (stand.rows() - 1)) * stand.row_spacing() * across +
-                    (i - 0.5 * (stand.per_row() - 1)) * stand.spacing() * along;
+                const glm::dvec2 p = (r - 0.5 * (stand.rows() - 1)) * stand.row_spacing() * across +
+                                     (i - 0.5 * (stand.per_row() - 1)) * stand.spacing() * along;
                 Placement placement;
                 placement.set_x(p.x);
                 placement.set_y(p.y);
@@ -117,8 +115,8 @@ v1::Mesh MakeMesh(const std::vector<glm::dvec3>& positions,
 
 // The unit leaf: a blade from its petiole at the origin to its tip at x = 1, width 1,
 // in the plane z = 0 with its upper side facing +z.
-const std::vector<glm::dvec3> kLeafOutline = {{0, 0, 0},     {0.3, -0.5, 0}, {0.7, -0.4, 0},
-                                              {1, 0, 0},     {0.7, 0.4, 0},  {0.3, 0.5, 0}};
+const std::vector<glm::dvec3> kLeafOutline = {{0, 0, 0}, {0.3, -0.5, 0}, {0.7, -0.4, 0},
+                                              {1, 0, 0}, {0.7, 0.4, 0},  {0.3, 0.5, 0}};
 
 // Area and centroid of the unit leaf (a fan of triangles from the petiole).
 std::pair<double, glm::dvec3> UnitLeafAreaCentroid() {
@@ -155,13 +153,12 @@ GrowthModel::GrowthModel(const Scenario& scenario) : scenario_(scenario) {
         Require(room.max().x() > room.min().x() && room.max().y() > room.min().y() &&
                     room.max().z() > room.min().z(),
                 "room", "max must exceed min on every axis");
-        Require(room.min().y() <= room.opening_y_min() &&
-                    room.opening_y_min() < room.opening_y_max() &&
-                    room.opening_y_max() <= room.max().y() &&
-                    room.min().z() <= room.opening_z_min() &&
-                    room.opening_z_min() < room.opening_z_max() &&
-                    room.opening_z_max() <= room.max().z(),
-                "room.opening_y_min", "the opening must lie within the wall");
+        Require(
+            room.min().y() <= room.opening_y_min() && room.opening_y_min() < room.opening_y_max() &&
+                room.opening_y_max() <= room.max().y() && room.min().z() <= room.opening_z_min() &&
+                room.opening_z_min() < room.opening_z_max() &&
+                room.opening_z_max() <= room.max().z(),
+            "room.opening_y_min", "the opening must lie within the wall");
         Require(!room.optics().empty(), "room.optics", "is empty");
     }
     for (const Placement& placement : Placements(scenario_)) {
@@ -315,12 +312,12 @@ std::vector<leaflux::v1::Surface> GrowthModel::Environment() const {
     out.push_back(Rectangle("room.ceiling", {lo.x, lo.y, hi.z}, {0, d.y, 0}, {d.x, 0, 0}, optics));
     out.push_back(Rectangle("room.wall_x_min", lo, {0, d.y, 0}, {0, 0, d.z}, optics));
     out.push_back(Rectangle("room.wall_y_min", lo, {0, 0, d.z}, {d.x, 0, 0}, optics));
-    out.push_back(Rectangle("room.wall_y_max", {lo.x, hi.y, lo.z}, {d.x, 0, 0}, {0, 0, d.z}, optics));
+    out.push_back(
+        Rectangle("room.wall_y_max", {lo.x, hi.y, lo.z}, {d.x, 0, 0}, {0, 0, d.z}, optics));
     // The wall at x = max, in four pieces around its opening.
     const auto piece = [&](const char* name, double y0, double y1, double z0, double z1) {
         if (y1 - y0 <= 0.0 || z1 - z0 <= 0.0) return;
-        out.push_back(
-            Rectangle(name, {hi.x, y0, z0}, {0, 0, z1 - z0}, {0, y1 - y0, 0}, optics));
+        out.push_back(Rectangle(name, {hi.x, y0, z0}, {0, 0, z1 - z0}, {0, y1 - y0, 0}, optics));
     };
     const double oy0 = room.opening_y_min(), oy1 = room.opening_y_max();
     const double oz0 = room.opening_z_min(), oz1 = room.opening_z_max();
@@ -363,8 +360,8 @@ glm::dmat3 GrowthModel::TurnTowardsLight(const Plant& plant, const Axis& axis,
     if (strength < 1e-9) return phyllotaxy;
     light /= strength;
     // Where the apex points now: the z axis of the last phytomer (or of the axis).
-    const NodeId apex = axis.phytomers.empty() ? axis.id
-                                               : plant.phytomers[axis.phytomers.back()].id;
+    const NodeId apex =
+        axis.phytomers.empty() ? axis.id : plant.phytomers[axis.phytomers.back()].id;
     const glm::dmat3 r(world.at(apex));
     const glm::dvec3 direction = glm::normalize(r[2]);
     const glm::dvec3 across = glm::cross(direction, light);
@@ -406,7 +403,8 @@ void GrowthModel::Grow(const std::map<NodeId, LeafLight>& light) {
             const std::size_t axes = plant.axes.size(), phytomers = plant.phytomers.size();
             for (std::size_t a = 0; a < axes; ++a) {
                 Axis& axis = plant.axes[a];
-                const int most = axis.order == 0 ? s.max_phytomers_main() : s.max_phytomers_branch();
+                const int most =
+                    axis.order == 0 ? s.max_phytomers_main() : s.max_phytomers_branch();
                 if (axis.growing && static_cast<int>(axis.phytomers.size()) >= most) {
                     axis.growing = false;
                 }
@@ -449,7 +447,8 @@ std::vector<PlantSummary> GrowthModel::Summaries() const {
             const double area = Species().specific_leaf_area_m2_per_g() * p.leafG;
             ++summary.leaves;
             summary.leafAreaM2 += area;
-            summary.leafCentroid += area * glm::dvec3(world.at(p.leaf) * glm::dvec4(unitCentroid, 1.0));
+            summary.leafCentroid +=
+                area * glm::dvec3(world.at(p.leaf) * glm::dvec4(unitCentroid, 1.0));
         }
         if (summary.leafAreaM2 > 0.0) summary.leafCentroid /= summary.leafAreaM2;
         out.push_back(summary);

@@ -24,10 +24,9 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <map>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "scenario.pb.h"
 
@@ -52,8 +51,8 @@ struct PlantSummary {
     NodeId id = 0;
     int leaves = 0;
     double leafAreaM2 = 0.0;
-    double biomassG = 0.0;        // everything the plant has built, seed included
-    double absorbedParW = 0.0;    // filled by the caller, who knows the light
+    double biomassG = 0.0;         // everything the plant has built, seed included
+    double absorbedParW = 0.0;     // filled by the caller, who knows the light
     glm::dvec3 leafCentroid{0.0};  // leaf-area weighted, world
 };
 

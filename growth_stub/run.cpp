@@ -33,7 +33,8 @@ const v1::BandLight* BandOf(const google::protobuf::RepeatedPtrField<v1::BandLig
 }
 
 LeafLight FromBand(const v1::BandLight& b) {
-    return {b.absorbed_w(), b.irradiance_upper_wm2() + b.irradiance_lower_wm2(),
+    return {b.absorbed_w(),
+            b.irradiance_upper_wm2() + b.irradiance_lower_wm2(),
             {b.light_vector().x(), b.light_vector().y(), b.light_vector().z()}};
 }
 
@@ -53,7 +54,8 @@ std::map<NodeId, LeafLight> LeafLightOf(const v1::CycleResult& result, const Gro
         }
     } else {
         for (const v1::OrganLight& organ : result.organs()) {
-            if (const v1::BandLight* b = BandOf(organ.bands(), band)) byNode[organ.node()] = FromBand(*b);
+            if (const v1::BandLight* b = BandOf(organ.bands(), band))
+                byNode[organ.node()] = FromBand(*b);
         }
     }
     std::map<NodeId, LeafLight> light;
@@ -121,8 +123,8 @@ void WritePly(const std::string& path, const Scenario& scenario, const GrowthMod
         for (const glm::dvec3& p : f.p) out << p.x << ' ' << p.y << ' ' << p.z << '\n';
     }
     for (std::size_t i = 0; i < faces.size(); ++i) {
-        out << "3 " << 3 * i << ' ' << 3 * i + 1 << ' ' << 3 * i + 2 << ' ' << faces[i].upper
-            << ' ' << faces[i].lower << '\n';
+        out << "3 " << 3 * i << ' ' << 3 * i + 1 << ' ' << 3 * i + 2 << ' ' << faces[i].upper << ' '
+            << faces[i].lower << '\n';
     }
     if (!out) throw std::runtime_error(path + ": cannot write");
 }
@@ -209,10 +211,9 @@ std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
         }
         if (!options.outDir.empty()) {
             cyclesCsv << c << ',' << record.leaves << ',' << record.leafAreaM2 << ','
-                      << record.biomassG << ',' << record.absorbedParW << ',' << record.added
-                      << ',' << record.updated << ',' << record.removed << ','
-                      << record.solveSeconds << ',' << record.roundTripSeconds << ','
-                      << record.daemonPeakMib << '\n';
+                      << record.biomassG << ',' << record.absorbedParW << ',' << record.added << ','
+                      << record.updated << ',' << record.removed << ',' << record.solveSeconds
+                      << ',' << record.roundTripSeconds << ',' << record.daemonPeakMib << '\n';
             for (const PlantSummary& plant : record.plants) {
                 plantsCsv << c << ',' << plant.id << ',' << plant.leaves << ',' << plant.leafAreaM2
                           << ',' << plant.biomassG << ',' << plant.absorbedParW << ','
@@ -225,11 +226,12 @@ std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
             }
         }
         if (!options.quiet) {
-            std::printf("cycle %3d: %5d leaves, %7.4f m², %8.3f g, PAR absorbed %8.3f W; "
-                        "+%d ~%d -%d nodes; solve %.3f s, round trip %.3f s, daemon %.0f MiB\n",
-                        c, record.leaves, record.leafAreaM2, record.biomassG, record.absorbedParW,
-                        record.added, record.updated, record.removed, record.solveSeconds,
-                        record.roundTripSeconds, record.daemonPeakMib);
+            std::printf(
+                "cycle %3d: %5d leaves, %7.4f m², %8.3f g, PAR absorbed %8.3f W; "
+                "+%d ~%d -%d nodes; solve %.3f s, round trip %.3f s, daemon %.0f MiB\n",
+                c, record.leaves, record.leafAreaM2, record.biomassG, record.absorbedParW,
+                record.added, record.updated, record.removed, record.solveSeconds,
+                record.roundTripSeconds, record.daemonPeakMib);
             std::fflush(stdout);
         }
         model.Grow(light);

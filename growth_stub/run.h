@@ -14,9 +14,9 @@ namespace leaflux::grow {
 
 struct RunOptions {
     int cycles = 25;
-    std::string outDir;           // cycles.csv, plants.csv, cycle<N>.ply; "" writes nothing
-    std::set<int> plyCycles;      // cycles whose geometry and light are written
-    bool branchLight = false;     // ask for per-axis light only, not per leaf
+    std::string outDir;        // cycles.csv, plants.csv, cycle<N>.ply; "" writes nothing
+    std::set<int> plyCycles;   // cycles whose geometry and light are written
+    bool branchLight = false;  // ask for per-axis light only, not per leaf
     bool quiet = false;
 };
 

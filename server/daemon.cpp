@@ -208,6 +208,7 @@ v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outp
             v1::StructureLight* structure = result.add_structures();
             structure->set_node(s.node);
             structure->set_name(s.name);
+            structure->set_type(TypeToProto(s.type));
             structure->set_organs(s.organCount);
             structure->set_area_m2(s.areaM2);
             BandsToProto(solved, s.bands, wanted, structure->mutable_bands());

@@ -112,26 +112,6 @@ NodeType TypeFromProto(v1::NodeType type) {
     }
 }
 
-v1::NodeType TypeToProto(NodeType type) {
-    switch (type) {
-        case NodeType::kPlant:
-            return v1::NODE_TYPE_PLANT;
-        case NodeType::kAxis:
-            return v1::NODE_TYPE_AXIS;
-        case NodeType::kPhytomer:
-            return v1::NODE_TYPE_PHYTOMER;
-        case NodeType::kLeaf:
-            return v1::NODE_TYPE_LEAF;
-        case NodeType::kInternode:
-            return v1::NODE_TYPE_INTERNODE;
-        case NodeType::kFruit:
-            return v1::NODE_TYPE_FRUIT;
-        case NodeType::kOther:
-            return v1::NODE_TYPE_OTHER;
-    }
-    return v1::NODE_TYPE_OTHER;
-}
-
 SkyDiscretization DiscretizationFromProto(v1::SkyDiscretization d) {
     switch (d) {
         case v1::SKY_DISCRETIZATION_TURTLE_46:
@@ -164,6 +144,26 @@ v1::SkyDiscretization DiscretizationToProto(SkyDiscretization d) {
 }
 
 }  // namespace
+
+v1::NodeType TypeToProto(NodeType type) {
+    switch (type) {
+        case NodeType::kPlant:
+            return v1::NODE_TYPE_PLANT;
+        case NodeType::kAxis:
+            return v1::NODE_TYPE_AXIS;
+        case NodeType::kPhytomer:
+            return v1::NODE_TYPE_PHYTOMER;
+        case NodeType::kLeaf:
+            return v1::NODE_TYPE_LEAF;
+        case NodeType::kInternode:
+            return v1::NODE_TYPE_INTERNODE;
+        case NodeType::kFruit:
+            return v1::NODE_TYPE_FRUIT;
+        case NodeType::kOther:
+            return v1::NODE_TYPE_OTHER;
+    }
+    return v1::NODE_TYPE_OTHER;
+}
 
 Sun SunFromProto(const Scene& scene, const v1::Sun& in, const std::string& field) {
     Sun sun;

@@ -29,6 +29,7 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory);
 
 // Shared meshes stay shared: each distinct mesh is written once in `meshes`.
 v1::Scene ToProto(const Scene& scene);
+v1::NodeType TypeToProto(NodeType type);
 
 // Reads a scene file in protobuf text format; parse errors name line and column.
 Scene LoadSceneFile(const std::string& path);

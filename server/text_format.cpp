@@ -39,10 +39,9 @@ std::optional<TextFormatError> ReadTextFormat(const std::string& path,
     if (parser.ParseFromString(text.str(), &message)) return std::nullopt;
     const auto& error = errors.Get();
     if (!error) return TextFormatError{false, path, "does not parse"};
-    return TextFormatError{false,
-                           path + ":" + std::to_string(error->line) + ":" +
-                               std::to_string(error->column),
-                           error->message};
+    return TextFormatError{
+        false, path + ":" + std::to_string(error->line) + ":" + std::to_string(error->column),
+        error->message};
 }
 
 }  // namespace leaflux

@@ -18,11 +18,12 @@ grow::Scenario Scenario(const std::string& name) {
 class GrowthOnLoopback : public DaemonOnLoopback {
   protected:
     std::vector<grow::CycleRecord> Grow(const grow::Scenario& scenario, int cycles,
-                                        grow::GrowthModel& model) {
+                                        grow::GrowthModel& model, bool branchLight = false) {
         Client client(server_->Endpoint());
         grow::RunOptions options;
         options.cycles = cycles;
         options.quiet = true;
+        options.branchLight = branchLight;
         return grow::Run(scenario, model, options, client);
     }
 };
@@ -94,6 +95,17 @@ TEST_F(GrowthOnLoopback, ScatteredLightMakesAPlantInARoomGrowMore) {
     grow::GrowthModel direct(scenario);
     const double directArea = Grow(scenario, 10, direct).back().leafAreaM2;
     EXPECT_GT(fullArea, 1.05 * directArea) << "full " << fullArea << ", direct " << directArea;
+}
+
+TEST_F(GrowthOnLoopback, BranchLevelLightIsEnoughToGrow) {
+    // Per-axis light only: each leaf gets its axis's irradiance and absorbed power per m².
+    const grow::Scenario scenario = Scenario("open-field");
+    grow::GrowthModel byLeaf(scenario), byBranch(scenario);
+    const double leafArea = Grow(scenario, 6, byLeaf).back().leafAreaM2;
+    const std::vector<grow::CycleRecord> records = Grow(scenario, 6, byBranch, true);
+    EXPECT_GT(records.back().biomassG, records.front().biomassG);
+    // A coarser answer, not a different plant: within a quarter of the per-leaf one.
+    EXPECT_NEAR(records.back().leafAreaM2, leafArea, 0.25 * leafArea);
 }
 
 TEST(GrowthModel, DiffNamesOnlyTheTopmostRemovedNode) {
