@@ -1,7 +1,6 @@
 // leaflux-grow: grows the plants of a scenario for a number of cycles, lit by leafluxd.
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
 #include "growth_stub/run.h"
@@ -60,8 +59,9 @@ int main(int argc, char** argv) {
 
         std::string serverKey;
         if (!curveKeyFile.empty()) {
-            std::ifstream in(curveKeyFile);
-            in >> serverKey;
+            const auto key = ReadCurveKey(curveKeyFile);
+            if (!key) throw std::invalid_argument(curveKeyFile + ": not a Z85 CurveZMQ public key");
+            serverKey = *key;
         }
         Client client(endpoint, serverKey);
         grow::GrowthModel model(scenario);

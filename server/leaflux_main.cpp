@@ -151,12 +151,12 @@ struct ClientCommand {
 int RunClient(const ClientCommand& command, const v1::Request& request) {
     std::string serverKey;
     if (!command.curveServerKeyFile.empty()) {
-        std::ifstream in(command.curveServerKeyFile);
-        in >> serverKey;
-        if (serverKey.size() != 40) {
+        const auto key = ReadCurveKey(command.curveServerKeyFile);
+        if (!key) {
             throw InputError(ErrorCode::kParse, command.curveServerKeyFile,
                              "not a Z85 CurveZMQ public key");
         }
+        serverKey = *key;
     }
     Client client(command.endpoint, serverKey, command.timeoutS * 1000);
     v1::Reply reply;

@@ -4,7 +4,6 @@
 
 #include <CLI/CLI.hpp>
 #include <csignal>
-#include <fstream>
 
 #include "server/daemon.h"
 #include "server/executor.h"
@@ -43,12 +42,12 @@ int main(int argc, char** argv) {
     transport.maxBytes = maxMegabytes << 20;
     std::string curveSecretKey;
     if (!curveKeyFile.empty()) {
-        std::ifstream in(curveKeyFile);
-        in >> curveSecretKey;
-        if (curveSecretKey.size() != 40) {
+        const auto key = ReadCurveKey(curveKeyFile);
+        if (!key) {
             spdlog::error("{}: not a Z85 CurveZMQ secret key (40 characters)", curveKeyFile);
             return 2;
         }
+        curveSecretKey = *key;
     }
     const bool loopback = bind.rfind("tcp://127.", 0) == 0 ||
                           bind.rfind("tcp://localhost", 0) == 0 || bind.rfind("ipc://", 0) == 0 ||

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <fstream>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -14,6 +15,13 @@ CurveKeyPair CurveKeyPair::Generate() {
     char publicKey[41], secretKey[41];
     if (zmq_curve_keypair(publicKey, secretKey) != 0) throw zmq::error_t();
     return {publicKey, secretKey};
+}
+
+std::optional<std::string> ReadCurveKey(const std::string& path) {
+    std::ifstream in(path);
+    std::string key;
+    if (!(in >> key) || key.size() != 40) return std::nullopt;
+    return key;
 }
 
 RouterServer::RouterServer(zmq::context_t& context, const std::string& endpoint,

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <functional>
+#include <optional>
 #include <string>
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
@@ -22,6 +23,10 @@ struct CurveKeyPair {
     std::string publicKey, secretKey;
     static CurveKeyPair Generate();
 };
+
+// The key a file written by `leaflux keygen` holds (40 Z85 characters); nullopt when the
+// file cannot be read or holds no such key.
+std::optional<std::string> ReadCurveKey(const std::string& path);
 
 class RouterServer {
   public:
