@@ -55,6 +55,7 @@ struct SolveStats {
     std::int64_t elements = 0;
     int refinementDepth = 0;  // deepest level of the hierarchy that links reach
     int iterations = 0;
+    int extrapolations = 0;  // jumps that accelerated the iteration
     double residual = 0.0;  // last relative change of the radiosity
 };
 

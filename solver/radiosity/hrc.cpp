@@ -49,9 +49,46 @@ Interpolation Locate(const DirectionSet& set, const glm::dvec3& direction) {
 }
 
 // Light from a node S to a node R.
+// Refine–solve passes after the first solution, and the Jacobi sweeps of each pass but the
+// last.
+constexpr int kRefinementPasses = 3;
+constexpr int kSweepsBeforeRerefining = 30;
+
+// Jacobi iteration converges like λᵏ, λ the spectral radius of the transport (≈ ρ + τ of
+// the leaves in a dense canopy or a closed room): at λ = 0.999 thousands of sweeps. The
+// ratio of successive changes estimates λ; once it is steady over three sweeps, the
+// remaining geometric series Δ·λ/(1 − λ) is added at once (Lyusternik's extrapolation),
+// and the change alone no longer says the iteration is done: what remains is Δ·λ/(1 − λ).
+class Convergence {
+  public:
+    // After a sweep that changed the radiosity by `change`: the factor by which to
+    // extrapolate that change, or 0.
+    double Step(double change) {
+        const double ratio = previous_ > 0.0 ? change / previous_ : 0.0;
+        previous_ = change;
+        steady_ = std::abs(ratio - ratio_) < 0.01 * ratio && ratio < 1.0 ? steady_ + 1 : 0;
+        ratio_ = ratio;
+        if (steady_ < 3 || ratio_ < 0.5) return 0.0;
+        steady_ = 0;
+        const double factor = ratio_ / (1.0 - ratio_);
+        previous_ = 0.0;  // the next change follows the jump: not a ratio of the series
+        return factor;
+    }
+    // The change still to come, estimated from the last one.
+    double Remaining(double change) const {
+        return ratio_ > 0.0 && ratio_ < 1.0 ? change * std::max(1.0, ratio_ / (1.0 - ratio_))
+                                            : change;
+    }
+
+  private:
+    double previous_ = 0.0, ratio_ = 0.0;
+    int steady_ = 0;
+};
+
 struct NodeLink {
     std::uint32_t sender = 0;
     bool exact = false;  // patch ← patch by the analytic form factor
+    float visibility = 0.0f;
     double formUpper = 0.0, formLower = 0.0, solidAngleSr = 0.0;
     int senderSide = kUpper;  // a patch sender: its side facing R
     // Cluster sender: v / d², times its intensity. Patch sender: v Ω / π, times its
@@ -262,6 +299,10 @@ class HrcSolver {
             radiosity_[child] = radiosity_[n];
             emitted_[child] = 0.25 * emitted_[n];
         }
+        if (n < direct_.size()) {  // after the first sweep: the parts keep the first arrival
+            direct_.resize(hierarchy_.Size(), Sided{});
+            for (std::uint32_t child : hierarchy_[n].children) direct_[child] = direct_[n];
+        }
         return true;
     }
 
@@ -327,20 +368,36 @@ class HrcSolver {
         }
     }
 
-    void RefinePair(std::uint32_t r, std::uint32_t s) {
+    // R's area facing the light of a sender in direction ω, for the error estimate: its
+    // projected area when the sender is small and far, up to its whole area as the sender
+    // widens (geometric error → 1) and its light may come from anywhere — a 10 m leaf seen
+    // edge-on from the centre of a 1 mm leaf above it lights the small leaf fully.
+    double ExposedArea(std::uint32_t r, const glm::dvec3& omega, double geometricError) const {
+        const double projected = ProjectedArea(r, omega);
+        return projected + geometricError * std::max(hierarchy_[r].areaM2 - projected, 0.0);
+    }
+
+    // What a link from s to r would carry and how wrong it may be, before visibility.
+    struct Estimate {
+        double geometric = 0.0;  // cluster link: see NodeLink; exact link: unused
+        SidedFormFactor form;    // exact link: at R's centre
+        double power = 0.0;      // W the link may carry, unoccluded
+        double geometricError = 0.0;
+        int senderSide = kUpper;
+        glm::dvec3 toSender{0, 0, 1};
+        bool near = false;  // exact link: R's centre does not speak for all of R
+    };
+
+    Estimate EstimatePair(std::uint32_t r, std::uint32_t s) const {
         const HrcNode& R = hierarchy_[r];
         const HrcNode& S = hierarchy_[s];
-        if (R.patch && S.patch) return RefineExact(r, s);
+        Estimate e;
         const glm::dvec3 between = S.centre - R.centre;
         const double d = glm::length(between);
-        const glm::dvec3 toSender = d > 0.0 ? between / d : glm::dvec3(0, 0, 1);
-        // A patch sends B/π over the solid angle it subtends; a cluster sends its intensity
-        // over d², which is bounded for overlapping clusters by the size of their union.
-        double geometric = 0.0, sender = 0.0, geometricError = 0.0;
-        int senderSide = kUpper;
+        if (d > 0.0) e.toSender = between / d;
         if (S.patch) {
             const glm::dvec3 centre = (S.a + S.b + S.c) / 3.0;
-            senderSide = glm::dot(S.normal, R.centroid - centre) >= 0.0 ? kUpper : kLower;
+            e.senderSide = glm::dot(S.normal, R.centroid - centre) >= 0.0 ? kUpper : kLower;
             // The solid angle at R's centroid, with the same second-order correction for
             // the spread of R's area as between clusters.
             const glm::dvec3 ra = glm::normalize(S.a - R.centroid),
@@ -349,13 +406,13 @@ class HrcSolver {
             const double square =
                 std::max(glm::dot(centre - R.centroid, centre - R.centroid), 1e-300);
             const double spread = std::min(R.spread * R.spread / (3.0 * square), 1.0);
-            geometric = SphericalTriangleSolidAngle(ra, rb, rc) / kPi * (1.0 + spread);
+            e.geometric = SphericalTriangleSolidAngle(ra, rb, rc) / kPi * (1.0 + spread);
             double radiosity = 0.0;
-            for (int b = 0; b < bands_; ++b) radiosity += radiosity_[s][senderSide][b];
-            sender = radiosity * geometric * ProjectedArea(r, toSender);
+            for (int b = 0; b < bands_; ++b) radiosity += radiosity_[s][e.senderSide][b];
             // One direction stands for the whole patch and R for all its points.
-            geometricError =
+            e.geometricError =
                 std::min(1.0, std::pow((R.radius + S.radius) / std::max(d, 1e-300), 2.0));
+            e.power = radiosity * e.geometric * ExposedArea(r, e.toSender, e.geometricError);
         } else {
             // 1/d² between centroids, times the mean of 1/|x − y|² over the two nodes' spread
             // of area to second order, 1 + (σ_R² + σ_S²) / (3 d²): without it the transfer
@@ -364,75 +421,114 @@ class HrcSolver {
             const double square =
                 std::max(glm::dot(gap, gap), 0.25 * std::pow(R.radius + S.radius, 2.0));
             const double spread = (R.spread * R.spread + S.spread * S.spread) / (3.0 * square);
-            geometric = std::min(1.0 + spread, 2.0) / square;
+            e.geometric = std::min(1.0 + spread, 2.0) / square;
             // The error bound does not trust the bounded transfer of overlapping clusters:
             // there, all the sender's power may land on the receiver.
-            sender = Power(s, -toSender) * ProjectedArea(r, toSender) / std::max(d * d, 1e-300);
-            geometricError =
+            e.geometricError =
                 std::min(1.0, std::pow(R.radius + S.radius, 2.0) / std::max(d * d, 1e-300));
+            e.power = Power(s, -e.toSender) * ExposedArea(r, e.toSender, e.geometricError) /
+                      std::max(d * d, 1e-300);
         }
-        sender = std::min(sender, emitted_[s]);
+        e.power = std::min(e.power, emitted_[s]);
         // Overlapping bounds: the direction between centroids says nothing (two leaves face
         // to face 1 µm apart have their centroids side by side), so any of the sender's
         // power may reach the receiver.
         if (glm::length(S.centroid - R.centroid) < R.radius + S.radius) {
-            sender = emitted_[s];
-            geometricError = 1.0;
+            e.power = emitted_[s];
+            e.geometricError = 1.0;
         }
-        // A sender still dark after the direct light is linked where it stands: it may
-        // light up as light bounces, and dropping it would lose that light.
-        // Geometry alone may call for a split: then no visibility rays are spent on it.
-        const double threshold = options_.epsilon * totalPower_;
-        if (sender * geometricError > threshold && Split(r, s)) return;
-        const double v = Visibility(r, s);
-        const double error =
-            sender * (geometricError + VisibilitySpread(v, options_.visibilityRays));
-        if (error > threshold && Split(r, s)) return;
-        if (v <= 0.0) return;
-        NodeLink link;
-        link.sender = s;
-        link.exact = false;
-        link.geometric = v * geometric;
-        link.senderSide = senderSide;
-        link.toSender = toSender;
-        link.receiverBins = Locate(directions_, toSender);
-        link.senderBins = Locate(directions_, -toSender);
-        links_[r].push_back(link);
+        return e;
     }
 
     // Patch ← patch: Lambert's formula at the receiver's centre, per side.
-    void RefineExact(std::uint32_t r, std::uint32_t s) {
+    Estimate EstimateExact(std::uint32_t r, std::uint32_t s) const {
         const HrcNode& R = hierarchy_[r];
         const HrcNode& S = hierarchy_[s];
+        Estimate e;
         const glm::dvec3 x = (R.a + R.b + R.c) / 3.0;
-        const SidedFormFactor f = PointToTriangle(x, R.normal, S.a, S.b, S.c);
-        const int senderSide =
-            glm::dot(S.normal, x - (S.a + S.b + S.c) / 3.0) >= 0.0 ? kUpper : kLower;
+        e.form = PointToTriangle(x, R.normal, S.a, S.b, S.c);
+        e.senderSide = glm::dot(S.normal, x - (S.a + S.b + S.c) / 3.0) >= 0.0 ? kUpper : kLower;
+        e.toSender = glm::normalize((S.a + S.b + S.c) / 3.0 - x);
         double radiosity = 0.0;
-        for (int b = 0; b < bands_; ++b) radiosity += radiosity_[s][senderSide][b];
+        for (int b = 0; b < bands_; ++b) radiosity += radiosity_[s][e.senderSide][b];
         const double d = std::max(glm::length(S.centroid - R.centroid), 1e-300);
         // The form factor at R's centroid speaks for all of R only when R is small against
         // the distance; otherwise parts of R may see S fully (F up to 1 on each side).
-        const bool near = R.radius > 0.5 * d;
-        if (!near && f.upper + f.lower <= 0.0) return;
-        const double unoccluded = radiosity * (near ? 1.0 : f.upper + f.lower) * R.areaM2;
+        e.near = R.radius > 0.5 * d;
+        e.power = radiosity * (e.near ? 1.0 : e.form.upper + e.form.lower) * R.areaM2;
+        e.geometricError = std::pow(R.radius / d, 2.0);
+        return e;
+    }
+
+    // Links s → r, or refines the pair when the link would carry more error than ε of the
+    // source power: a sender still dark is linked where it stands, and relinked by
+    // Rerefine once it has lit up.
+    void RefinePair(std::uint32_t r, std::uint32_t s) {
+        const bool exact = hierarchy_[r].patch && hierarchy_[s].patch;
+        const Estimate e = exact ? EstimateExact(r, s) : EstimatePair(r, s);
+        if (exact && !e.near && e.form.upper + e.form.lower <= 0.0) return;
+        // Geometry alone may call for a split: then no visibility rays are spent on it.
         const double threshold = options_.epsilon * totalPower_;
-        const double geometricError = std::pow(R.radius / d, 2.0);
-        if (unoccluded * geometricError > threshold && Split(r, s)) return;
+        if (e.power * e.geometricError > threshold && Split(r, s)) return;
         const double v = Visibility(r, s);
         const double error =
-            unoccluded * (geometricError + VisibilitySpread(v, options_.visibilityRays));
+            e.power * (e.geometricError + VisibilitySpread(v, options_.visibilityRays));
         if (error > threshold && Split(r, s)) return;
-        if (v <= 0.0 || f.upper + f.lower <= 0.0) return;
+        if (v <= 0.0 || (exact && e.form.upper + e.form.lower <= 0.0)) return;
         NodeLink link;
         link.sender = s;
-        link.exact = true;
-        link.formUpper = f.upper * v;
-        link.formLower = f.lower * v;
-        link.solidAngleSr = f.solidAngleSr * v;
-        link.senderSide = senderSide;
-        link.toSender = glm::normalize((S.a + S.b + S.c) / 3.0 - x);
+        link.exact = exact;
+        link.visibility = static_cast<float>(v);
+        link.senderSide = e.senderSide;
+        link.toSender = e.toSender;
+        if (exact) {
+            link.formUpper = e.form.upper * v;
+            link.formLower = e.form.lower * v;
+            link.solidAngleSr = e.form.solidAngleSr * v;
+        } else {
+            link.geometric = v * e.geometric;
+            link.receiverBins = Locate(directions_, e.toSender);
+            link.senderBins = Locate(directions_, -e.toSender);
+        }
         links_[r].push_back(link);
+    }
+
+    // Refinement judges a link by the light its sender sends when it is made: a sender lit
+    // only by light scattered later (a wall facing away from a lamp, the ceiling of a
+    // closed greenhouse) was dark then and linked coarsely. With the radiosities of a
+    // solution, every link is judged again and split where its error now exceeds ε (the
+    // classic refine–solve loop of hierarchical radiosity). True when a link was split.
+    bool Rerefine() {
+        const double threshold = options_.epsilon * totalPower_;
+        bool split = false;
+        const std::size_t count = links_.size();
+        for (std::uint32_t r = 0; r < count; ++r) {
+            if (links_[r].empty()) continue;
+            std::vector<NodeLink> kept;
+            std::vector<std::uint32_t> refine;
+            for (const NodeLink& link : links_[r]) {
+                const Estimate e =
+                    link.exact ? EstimateExact(r, link.sender) : EstimatePair(r, link.sender);
+                const double error =
+                    e.power *
+                    (e.geometricError + VisibilitySpread(link.visibility, options_.visibilityRays));
+                if (error > threshold) {
+                    refine.push_back(link.sender);
+                } else {
+                    kept.push_back(link);
+                }
+            }
+            if (refine.empty()) continue;
+            links_[r] = std::move(kept);
+            for (std::uint32_t s : refine) {
+                if (Split(r, s)) {
+                    split = true;
+                } else {
+                    RefinePair(r, s);  // neither can be split: the link as it was
+                }
+            }
+        }
+        return split;
     }
 
     // ---- Solution -----------------------------------------------------------------------
@@ -466,6 +562,7 @@ class HrcSolver {
     void PushDown(bool sourcesOnly);
     void PushSubtree(std::uint32_t start, const Level& above, bool sourcesOnly);
     double UpdateRadiosity();
+    void Extrapolate(double factor);
     void Outputs(Solution& solution);
 
     const Scene& scene_;
@@ -499,6 +596,7 @@ class HrcSolver {
     std::vector<std::uint32_t> receivers_;                       // nodes with links
     // Leaf patches: the light of the last push.
     std::vector<Sided> irradiance_, direct_;
+    std::vector<Sided> change_;  // leaf patches: of the last sweep
     std::vector<Spectrum> integral_;
     std::vector<Moment> moment_;
     std::vector<Spectrum> emission_;  // exitance of emitter patches
@@ -536,7 +634,6 @@ void HrcSolver<kBands>::Index() {
         }
         projected_.assign(static_cast<std::size_t>(slots) * bins_, 0.0);
         intensity_.assign(static_cast<std::size_t>(slots) * bins_ * bands_, 0.0);
-        gatheredBins_.assign(intensity_.size(), 0.0);
         for (auto it = preOrder_.rbegin(); it != preOrder_.rend(); ++it) {
             const HrcNode& node = hierarchy_[*it];
             if (node.patch) continue;
@@ -550,11 +647,15 @@ void HrcSolver<kBands>::Index() {
     }
     slot_.resize(hierarchy_.Size(), kNoNode);
     const std::size_t size = hierarchy_.Size();
+    // Gathering rewrites only nodes with links: a node whose links refinement moved to
+    // its children must hand down nothing.
+    gatheredBins_.assign(intensity_.size(), 0.0);
     gatheredSides_.assign(size, Sided{});
     gatheredIntegral_.assign(size, Spectrum{});
     gatheredMoment_.assign(size, {});
     irradiance_.resize(size, Sided{});
     direct_.resize(size, Sided{});
+    change_.resize(size, Sided{});
     integral_.resize(size, Spectrum{});
     moment_.resize(size, {});
     emission_.assign(size, Spectrum{});
@@ -778,6 +879,8 @@ double HrcSolver<kBands>::UpdateRadiosity() {
                     acc.first = std::max({acc.first, std::abs(upper - radiosity_[n][kUpper][k]),
                                           std::abs(lower - radiosity_[n][kLower][k])});
                     acc.second = std::max({acc.second, upper, lower});
+                    change_[n][kUpper][k] = upper - radiosity_[n][kUpper][k];
+                    change_[n][kLower][k] = lower - radiosity_[n][kLower][k];
                     radiosity_[n][kUpper][k] = upper;
                     radiosity_[n][kLower][k] = lower;
                 }
@@ -788,6 +891,19 @@ double HrcSolver<kBands>::UpdateRadiosity() {
             return std::pair{std::max(a.first, b.first), std::max(a.second, b.second)};
         });
     return largest > 0.0 ? change / largest : 0.0;
+}
+
+template <int kBands>
+void HrcSolver<kBands>::Extrapolate(double factor) {
+    tbb::parallel_for(std::size_t{0}, leaves_.size(), [&](std::size_t i) {
+        const std::uint32_t n = leaves_[i];
+        for (int s : {kUpper, kLower}) {
+            for (int k = 0; k < bands_; ++k) {
+                double& b = radiosity_[n][s][k];
+                b = std::max(b + factor * change_[n][s][k], 0.0);
+            }
+        }
+    });
 }
 
 template <int kBands>
@@ -825,22 +941,42 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
     Index();
     const double refineSeconds = clock.Lap();
 
-    // Jacobi from the emission: the first sweep's light is the direct light.
+    // Jacobi from the emission: the first sweep's light is the direct light. Then the links
+    // are judged again with the light of the solution and the iteration goes on from it,
+    // until no link needs refining (a pass or two).
     for (std::uint32_t n : preOrder_) radiosity_[n] = Sided{}, radiosity_[n][kUpper] = emission_[n];
     PullUp();
     double residual = 0.0;
     int iteration = 0;
     const int iterations = options_.directOnly ? 1 : options_.maxIterations;
-    for (; iteration < iterations; ++iteration) {
-        Gather();
-        PushDown(false);
-        if (iteration == 0) direct_ = irradiance_;
-        residual = UpdateRadiosity();
-        PullUp();
-        if (residual <= options_.tolerance) break;
+    bool settled = false;
+    Convergence convergence;
+    for (int pass = 0;; ++pass) {
+        const bool last = options_.directOnly || settled || pass == kRefinementPasses;
+        // Light to a few percent is all that refinement needs.
+        const double tolerance = last ? options_.tolerance : std::max(options_.tolerance, 1e-2);
+        convergence = Convergence{};
+        for (int sweep = 0; iteration < iterations; ++iteration, ++sweep) {
+            Gather();
+            PushDown(false);
+            if (iteration == 0) direct_ = irradiance_;
+            residual = UpdateRadiosity();
+            if (const double factor = convergence.Step(residual); factor > 0.0) {
+                Extrapolate(factor);
+                ++solution.stats.extrapolations;
+            }
+            PullUp();
+            if (convergence.Remaining(residual) <= tolerance ||
+                (!last && sweep == kSweepsBeforeRerefining))
+                break;
+        }
+        if (last) break;
+        settled = !Rerefine();
+        if (!settled) Index();
+        ++iteration;
     }
-    solution.stats.iterations = iteration + 1;
-    solution.stats.residual = residual;
+    solution.stats.iterations = std::min(iteration + 1, iterations);
+    solution.stats.residual = convergence.Remaining(residual);
     const double solveSeconds = clock.Lap();
     Outputs(solution);
     spdlog::debug(
