@@ -504,27 +504,22 @@ class HrcSolver {
         const std::size_t count = links_.size();
         for (std::uint32_t r = 0; r < count; ++r) {
             if (links_[r].empty()) continue;
-            std::vector<NodeLink> kept;
-            std::vector<std::uint32_t> refine;
+            std::vector<NodeLink> kept, refine;
             for (const NodeLink& link : links_[r]) {
                 const Estimate e =
                     link.exact ? EstimateExact(r, link.sender) : EstimatePair(r, link.sender);
                 const double error =
                     e.power *
                     (e.geometricError + VisibilitySpread(link.visibility, options_.visibilityRays));
-                if (error > threshold) {
-                    refine.push_back(link.sender);
-                } else {
-                    kept.push_back(link);
-                }
+                (error > threshold ? refine : kept).push_back(link);
             }
             if (refine.empty()) continue;
             links_[r] = std::move(kept);
-            for (std::uint32_t s : refine) {
-                if (Split(r, s)) {
+            for (const NodeLink& link : refine) {
+                if (Split(r, link.sender)) {
                     split = true;
                 } else {
-                    RefinePair(r, s);  // neither can be split: the link as it was
+                    links_[r].push_back(link);  // neither can be split: the link stays
                 }
             }
         }
