@@ -56,7 +56,7 @@ struct SolveStats {
     int refinementDepth = 0;  // deepest level of the hierarchy that links reach
     int iterations = 0;
     int extrapolations = 0;  // jumps that accelerated the iteration
-    double residual = 0.0;   // last relative change of the radiosity
+    double residual = 0.0;   // relative change of the radiosity still to come
 };
 
 // Wall and CPU time and peak memory of a solve, from its start to Stamp.

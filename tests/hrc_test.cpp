@@ -156,21 +156,6 @@ TEST(HrcTree, StiffLeavesGiveAFiniteConvergedAnswer) {
     ExpectFiniteLight(hrc);
 }
 
-Scene TwoLeaves(double gap, glm::dvec3 offset) {
-    Scene scene = OneBandScene({{"leaf", Leaf(0.45, 0.45)}});
-    auto at = [&](double z) {
-        return Quad(offset + glm::dvec3(-0.05, -0.05, z), offset + glm::dvec3(0.05, -0.05, z),
-                    offset + glm::dvec3(0.05, 0.05, z), offset + glm::dvec3(-0.05, 0.05, z));
-    };
-    scene.nodes.push_back(OrganNode(1, "top", at(1.0 + gap), "leaf"));
-    auto shifted = [&](double z) {
-        return Quad(offset + glm::dvec3(-0.02, -0.05, z), offset + glm::dvec3(0.08, -0.05, z),
-                    offset + glm::dvec3(0.08, 0.05, z), offset + glm::dvec3(-0.02, 0.05, z));
-    };
-    scene.nodes.push_back(OrganNode(2, "bottom", shifted(1.0), "leaf"));
-    return scene;
-}
-
 // Direct light only: the sun's light arrives, what the leaves scatter does not. The top
 // leaf's upper side sees the sun alone either way; its lower side gets only what the
 // bottom leaf reflects, and the bottom leaf's shaded part only what the top one transmits.

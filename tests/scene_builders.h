@@ -96,6 +96,19 @@ inline Scene Furnace(double rho, double exitance) {
     return scene;
 }
 
+// Two 10 cm square leaves (ρ = τ = 0.45), one `gap` above the other and shifted 3 cm
+// sideways, at z = 1 m, the whole moved by `offset`; no sources.
+inline Scene TwoLeaves(double gap, glm::dvec3 offset) {
+    Scene scene = OneBandScene({{"leaf", Leaf(0.45, 0.45)}});
+    auto square = [&](double x0, double x1, double z) {
+        return Quad(offset + glm::dvec3(x0, -0.05, z), offset + glm::dvec3(x1, -0.05, z),
+                    offset + glm::dvec3(x1, 0.05, z), offset + glm::dvec3(x0, 0.05, z));
+    };
+    scene.nodes.push_back(OrganNode(1, "top", square(-0.05, 0.05, 1.0 + gap), "leaf"));
+    scene.nodes.push_back(OrganNode(2, "bottom", square(-0.02, 0.08, 1.0), "leaf"));
+    return scene;
+}
+
 // Every receiver's irradiance, each band and side, is a finite, non-negative number.
 inline void ExpectFiniteLight(const Solution& solution) {
     for (const auto& bands : solution.light) {

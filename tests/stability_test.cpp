@@ -150,14 +150,9 @@ Scene ClosedBox(double scatter) {
     return scene;
 }
 
-Scene TwoLeaves(double gap, glm::dvec3 offset) {
-    Scene scene = OneBandScene({{"leaf", Leaf(0.45, 0.45)}});
-    auto square = [&](double x0, double x1, double z) {
-        return Quad(offset + glm::dvec3(x0, -0.05, z), offset + glm::dvec3(x1, -0.05, z),
-                    offset + glm::dvec3(x1, 0.05, z), offset + glm::dvec3(x0, 0.05, z));
-    };
-    scene.nodes.push_back(OrganNode(1, "top", square(-0.05, 0.05, 1.0 + gap), "leaf"));
-    scene.nodes.push_back(OrganNode(2, "bottom", square(-0.02, 0.08, 1.0), "leaf"));
+// TwoLeaves (scene_builders.h) under a sun at 60°.
+Scene TwoLitLeaves(double gap, glm::dvec3 offset) {
+    Scene scene = TwoLeaves(gap, offset);
     scene.sources.suns.push_back(SunAt(60, 30, kSunWm2));
     return scene;
 }
@@ -236,7 +231,7 @@ INSTANTIATE_TEST_SUITE_P(EverySolver, StiffStability,
                          });
 
 TEST_P(Stability, LeavesOneMicrometreApart) {
-    const Solution solution = Run(TwoLeaves(1e-6, glm::dvec3(0.0)));
+    const Solution solution = Run(TwoLitLeaves(1e-6, glm::dvec3(0.0)));
     ExpectBalanced(solution, Kind(), 0.02);
     ExpectCloseToReference(Prepared(), solution);
 }
@@ -267,7 +262,7 @@ TEST_P(Stability, LampOneMillimetreBelowALeaf) {
 }
 
 TEST_P(Stability, SunHalfADegreeAboveTheHorizon) {
-    Scene scene = TwoLeaves(0.02, glm::dvec3(0.0));
+    Scene scene = TwoLitLeaves(0.02, glm::dvec3(0.0));
     scene.nodes[0].organ->mesh =
         Quad({0, -0.05, 0.95}, {0, 0.05, 0.95}, {0, 0.05, 1.05}, {0, -0.05, 1.05});
     scene.sources.suns = {SunAt(0.5, 90, kSunWm2)};
@@ -348,7 +343,7 @@ TEST_P(Stability, CoordinatesOffsetAHundredKilometres) {
     EXPECT_NEAR(one.light[0][0].irradianceUpperWm2, 0.5 * kSunWm2, 1e-6 * kSunWm2);
     EXPECT_NEAR(one.light[0][0].absorbedW, 0.85 * 0.5 * kSunWm2 * 0.01, 1e-6);
 
-    const Solution two = Run(TwoLeaves(0.02, offset));
+    const Solution two = Run(TwoLitLeaves(0.02, offset));
     ExpectBalanced(two, Kind());
     ExpectCloseToReference(Prepared(), two);
 }

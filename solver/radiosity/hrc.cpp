@@ -48,7 +48,6 @@ Interpolation Locate(const DirectionSet& set, const glm::dvec3& direction) {
     return {located.vertex, located.weight};
 }
 
-// Light from a node S to a node R.
 // Refine–solve passes after the first solution, and the Jacobi sweeps of each pass but the
 // last.
 constexpr int kRefinementPasses = 3;
@@ -85,6 +84,7 @@ class Convergence {
     int steady_ = 0;
 };
 
+// Light from a node S to a node R.
 struct NodeLink {
     std::uint32_t sender = 0;
     bool exact = false;  // patch ← patch by the analytic form factor
@@ -871,11 +871,11 @@ double HrcSolver<kBands>::UpdateRadiosity() {
                                          o.tau[kLower][k] * e[kLower][k];
                     const double lower =
                         o.rho[kLower][k] * e[kLower][k] + o.tau[kUpper][k] * e[kUpper][k];
-                    acc.first = std::max({acc.first, std::abs(upper - radiosity_[n][kUpper][k]),
-                                          std::abs(lower - radiosity_[n][kLower][k])});
-                    acc.second = std::max({acc.second, upper, lower});
                     change_[n][kUpper][k] = upper - radiosity_[n][kUpper][k];
                     change_[n][kLower][k] = lower - radiosity_[n][kLower][k];
+                    acc.first = std::max({acc.first, std::abs(change_[n][kUpper][k]),
+                                          std::abs(change_[n][kLower][k])});
+                    acc.second = std::max({acc.second, upper, lower});
                     radiosity_[n][kUpper][k] = upper;
                     radiosity_[n][kLower][k] = lower;
                 }

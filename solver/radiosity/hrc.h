@@ -13,7 +13,10 @@
 // estimated error — the power it carries times its geometric error ((r_R + r_S)/d)² plus
 // its visibility spread 2√(v(1−v)) — exceeds ε times the power the sources bring into the
 // scene. Solution: Jacobi gathering with push/pull (B₁ = ρ₁I₁ + τ₂→₁I₂, B₂ = ρ₂I₂ + τ₁→₂I₁;
-// what is pulled up is the intensity of both sides), iterated to a residual tolerance.
+// what is pulled up is the intensity of both sides), accelerated by extrapolating the
+// geometric series of the changes and iterated until the change still to come is below
+// the tolerance; between solutions every link is judged again with the light found
+// (refine–solve passes), so that senders dark when first linked are refined too.
 #pragma once
 
 #include <cstdint>
@@ -29,8 +32,8 @@ struct HrcOptions {
     int maxSubdivision = 3;   // a triangle splits into at most 4^this patches
     int visibilityRays = 8;   // per link (stratified pairs of points)
     int directionLevel = 2;   // direction set of cluster light: 2 → 34 directions
-    double tolerance = 1e-5;  // iteration stops when the radiosity changes less than
-                              // this times its maximum
+    double tolerance = 1e-5;  // iteration stops when the change still to come is less
+                              // than this times the largest radiosity
     int maxIterations = 2000;
     // Direct light only: one gathering sweep from the sources and lamps, no links for
     // light scattered by leaves and surfaces (it shows as missing in the energy balance).
