@@ -7,10 +7,12 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 
+#include "server/bench_error.h"
 #include "server/client.h"
 #include "server/scene_proto.h"
 #include "solver/error.h"
@@ -341,11 +343,63 @@ int main(int argc, char** argv) {
     closeApp->add_option("--session", client.session, "Session id")->required();
     CLI::App* shutdownApp = clientApp->add_subcommand("shutdown", "Stop the daemon");
 
+    ErrorBenchOptions errorBench;
+    errorBench.plotScript = LEAFLUX_PLOT_ERROR_SCRIPT;
+    std::string errorBenchOut = "out/bench/error";
+    bool noPlot = false;
+    CLI::App* benchApp = app.add_subcommand("bench", "Measure the solvers");
+    benchApp->require_subcommand(1);
+    CLI::App* errorApp = benchApp->add_subcommand(
+        "error",
+        "Error against run time on one scene: a cached Monte Carlo reference, then every "
+        "solver at several settings (wall and CPU time, peak memory, L2 error in % of the "
+        "reference maximum, mean and 95th-percentile relative error over lit leaves, energy "
+        "balance, per band); writes OUT/NAME.csv and OUT/NAME.png");
+    errorApp->add_option("--scene", errorBench.scene, "Scene file")
+        ->required()
+        ->check(CLI::ExistingFile);
+    errorApp->add_option("--name", errorBench.name, "The scene's name (default: the file's)");
+    errorApp->add_option("--out", errorBenchOut, "Directory of the CSV and the plot");
+    errorApp->add_option("--cache", errorBench.cacheDirectory,
+                         "Directory of cached references (default: " + DefaultCacheDirectory() +
+                             "); delete a file there to solve it again");
+    errorApp
+        ->add_option("--reference-samples", errorBench.referenceSamples,
+                     "Reference: Monte Carlo paths per receiver")
+        ->check(CLI::Range(2, 1 << 26));
+    errorApp->add_option("--reference-seed", errorBench.referenceSeed, "Reference: random seed");
+    errorApp
+        ->add_option("--mc-samples", errorBench.monteCarloSamples,
+                     "Monte Carlo runs: paths per receiver of each")
+        ->delimiter(',')
+        ->check(CLI::Range(2, 1 << 26));
+    errorApp->add_option("--hrc-epsilon", errorBench.hrcEpsilons, "HRC runs: ε of each")
+        ->delimiter(',')
+        ->check(CLI::Range(1e-9, 1.0));
+    errorApp->add_flag("!--no-direct", errorBench.directOnly,
+                       "No direct-light-only run (HRC at the finest ε)");
+    bool noMonteCarlo = false, noHrc = false;
+    errorApp->add_flag("--no-mc", noMonteCarlo, "No Monte Carlo run (but the reference)");
+    errorApp->add_flag("--no-hrc", noHrc, "No HRC run");
+    errorApp->add_flag("--no-plot", noPlot, "CSV and table only");
+    errorApp->add_option("--threads", errorBench.threads, "Worker threads (0: every core)")
+        ->check(CLI::Range(0, 1024));
+
     CLI11_PARSE(app, argc, argv);
     spdlog::cfg::load_env_levels();  // SPDLOG_LEVEL=debug shows the solvers' phases
     try {
         if (solveApp->parsed()) return RunSolve(solve);
         if (generateApp->parsed()) return RunGenerate(generate);
+        if (errorApp->parsed()) {
+            if (errorBench.name.empty()) {
+                errorBench.name = std::filesystem::path(errorBench.scene).stem().stem().string();
+            }
+            if (noMonteCarlo) errorBench.monteCarloSamples.clear();
+            if (noHrc) errorBench.hrcEpsilons.clear();
+            errorBench.csv = errorBenchOut + "/" + errorBench.name + ".csv";
+            if (!noPlot) errorBench.png = errorBenchOut + "/" + errorBench.name + ".png";
+            return RunErrorBench(errorBench);
+        }
         if (keygenApp->parsed()) {
             const CurveKeyPair keys = CurveKeyPair::Generate();
             std::ofstream(keyPrefix + ".secret") << keys.secretKey << '\n';

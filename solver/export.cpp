@@ -4,14 +4,13 @@
 #include <sstream>
 
 namespace leaflux {
-namespace {
-
-// Shortest text that reads back to the same double.
 std::string Number(double value) {
     char buffer[32];
     std::snprintf(buffer, sizeof buffer, "%.9g", value);
     return buffer;
 }
+
+namespace {
 
 std::string Quoted(const std::string& text) {
     if (text.find_first_of(",\"\n") == std::string::npos) return text;

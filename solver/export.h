@@ -9,6 +9,9 @@
 
 namespace leaflux {
 
+// A number for a CSV or a summary: nine significant digits, no trailing zeros.
+std::string Number(double value);
+
 // One row per receiver and band, columns:
 // organ,band,area_m2,irradiance_upper_wm2,irradiance_lower_wm2,absorbed_w,
 // light_x,light_y,light_z,stderr_upper_wm2,stderr_lower_wm2

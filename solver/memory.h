@@ -5,8 +5,13 @@
 
 namespace leaflux {
 
-// Peak resident set size of the process so far (bytes), from the kernel.
+// Peak resident set size of the process (bytes) since it started or since the last
+// successful ResetPeakRss, from the kernel.
 std::int64_t PeakRssBytes();
+// Starts a new peak at the current resident size, so that one process can measure the
+// peak of several runs in turn (Linux /proc/self/clear_refs). False when the kernel does
+// not allow it: the peak then stays the process's.
+bool ResetPeakRss();
 // CPU time used by the process so far, all threads (seconds).
 double CpuSeconds();
 

@@ -1,0 +1,334 @@
+#include "server/bench_error.h"
+
+#include <google/protobuf/io/coded_stream.h>
+#include <google/protobuf/io/zero_copy_stream_impl_lite.h>
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+
+#include "server/scene_proto.h"
+#include "solver/accuracy.h"
+#include "solver/error.h"
+#include "solver/export.h"
+#include "solver/memory.h"
+#include "solver/solve.h"
+
+namespace leaflux {
+namespace {
+
+// Bumped whenever the Monte Carlo solver's answer for a given seed changes, so that old
+// cached references are not taken for new ones.
+constexpr std::uint64_t kReferenceVersion = 1;
+constexpr char kCacheMagic[8] = {'L', 'F', 'X', 'R', 'E', 'F', '0', '1'};
+
+// FNV-1a, 64 bits: stable across compilers and runs, unlike std::hash.
+class Fingerprint {
+  public:
+    void Add(const void* data, std::size_t size) {
+        const auto* bytes = static_cast<const unsigned char*>(data);
+        for (std::size_t i = 0; i < size; ++i) hash_ = (hash_ ^ bytes[i]) * 0x100000001b3ULL;
+    }
+    template <typename T>
+    void Add(const T& value) {
+        Add(&value, sizeof value);
+    }
+    std::string Hex() const {
+        char text[17];
+        std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash_));
+        return text;
+    }
+
+  private:
+    std::uint64_t hash_ = 0xcbf29ce484222325ULL;
+};
+
+// The scene as the solvers see it (imports read, defaults filled) and the reference's
+// settings; not the file's bytes, so that a comment or a moved import does not matter.
+std::string ReferenceKey(const Scene& scene, const ReferenceOptions& options) {
+    std::string bytes;
+    {
+        google::protobuf::io::StringOutputStream stream(&bytes);
+        google::protobuf::io::CodedOutputStream coded(&stream);
+        coded.SetSerializationDeterministic(true);
+        ToProto(scene).SerializeToCodedStream(&coded);
+    }
+    Fingerprint key;
+    key.Add(bytes.data(), bytes.size());
+    key.Add(kReferenceVersion);
+    key.Add(options.samplesPerReceiver);
+    key.Add(options.replicates);
+    key.Add(options.seed);
+    return key.Hex();
+}
+
+void WriteDoubles(std::ostream& out, std::initializer_list<double> values) {
+    for (double v : values) out.write(reinterpret_cast<const char*>(&v), sizeof v);
+}
+
+void WriteCachedReference(const std::filesystem::path& path, const Solution& solution) {
+    std::filesystem::create_directories(path.parent_path());
+    const std::filesystem::path partial = path.string() + ".partial";
+    {
+        std::ofstream out(partial, std::ios::binary);
+        out.write(kCacheMagic, sizeof kCacheMagic);
+        const std::uint64_t receivers = solution.light.size();
+        const std::uint64_t bands = solution.balance.size();
+        out.write(reinterpret_cast<const char*>(&receivers), sizeof receivers);
+        out.write(reinterpret_cast<const char*>(&bands), sizeof bands);
+        const SolveStats& stats = solution.stats;
+        WriteDoubles(out,
+                     {stats.wallSeconds, stats.cpuSeconds, static_cast<double>(stats.peakRssBytes),
+                      static_cast<double>(stats.rays), static_cast<double>(stats.threads)});
+        for (const EnergyBalance& e : solution.balance) {
+            WriteDoubles(out, {e.incidentW, e.absorbedW, e.escapedW, e.stderrW});
+        }
+        for (const auto& receiver : solution.light) {
+            for (const BandLight& l : receiver) {
+                WriteDoubles(out, {l.irradianceUpperWm2, l.irradianceLowerWm2, l.absorbedW,
+                                   l.radianceIntegral, l.radianceMoment.x, l.radianceMoment.y,
+                                   l.radianceMoment.z, l.stderrUpperWm2, l.stderrLowerWm2,
+                                   l.stderrAbsorbedW});
+            }
+        }
+        if (!out) throw InputError(ErrorCode::kIo, partial.string(), "cannot write");
+    }
+    std::filesystem::rename(partial, path);  // whole or absent, never half written
+}
+
+// The cached reference, or nothing when there is none or it does not fit the scene.
+std::optional<Solution> ReadCachedReference(const std::filesystem::path& path,
+                                            std::size_t receivers, std::size_t bands) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return std::nullopt;
+    char magic[sizeof kCacheMagic];
+    std::uint64_t storedReceivers = 0, storedBands = 0;
+    in.read(magic, sizeof magic);
+    in.read(reinterpret_cast<char*>(&storedReceivers), sizeof storedReceivers);
+    in.read(reinterpret_cast<char*>(&storedBands), sizeof storedBands);
+    if (!in || !std::equal(magic, magic + sizeof magic, kCacheMagic) ||
+        storedReceivers != receivers || storedBands != bands) {
+        spdlog::warn("{}: not a reference for this scene; solving again", path.string());
+        return std::nullopt;
+    }
+    auto next = [&in] {
+        double v = 0.0;
+        in.read(reinterpret_cast<char*>(&v), sizeof v);
+        return v;
+    };
+    Solution solution;
+    SolveStats& stats = solution.stats;
+    stats.wallSeconds = next();
+    stats.cpuSeconds = next();
+    stats.peakRssBytes = static_cast<std::int64_t>(next());
+    stats.rays = static_cast<std::int64_t>(next());
+    stats.threads = static_cast<int>(next());
+    solution.balance.resize(bands);
+    for (EnergyBalance& e : solution.balance) {
+        e = {next(), next(), next(), next()};
+    }
+    solution.light.assign(receivers, std::vector<BandLight>(bands));
+    for (auto& receiver : solution.light) {
+        for (BandLight& l : receiver) {
+            l.irradianceUpperWm2 = next();
+            l.irradianceLowerWm2 = next();
+            l.absorbedW = next();
+            l.radianceIntegral = next();
+            l.radianceMoment = {next(), next(), next()};
+            l.stderrUpperWm2 = next();
+            l.stderrLowerWm2 = next();
+            l.stderrAbsorbedW = next();
+        }
+    }
+    if (!in || in.peek() != std::char_traits<char>::eof()) {
+        spdlog::warn("{}: truncated or overlong; solving again", path.string());
+        return std::nullopt;
+    }
+    return solution;
+}
+
+struct Run {
+    std::string solver, setting;
+    SolverSettings settings;
+};
+
+std::vector<Run> Runs(const ErrorBenchOptions& options) {
+    std::vector<Run> runs;
+    SolverSettings base;
+    base.monteCarlo.threads = base.hrc.threads = options.threads;
+    for (int samples : options.monteCarloSamples) {
+        Run run{"mc", "samples=" + std::to_string(samples), base};
+        run.settings.kind = SolverKind::kMonteCarlo;
+        run.settings.monteCarlo.samplesPerReceiver = samples;
+        runs.push_back(run);
+    }
+    for (double epsilon : options.hrcEpsilons) {
+        Run run{"hrc", "epsilon=" + Number(epsilon), base};
+        run.settings.kind = SolverKind::kHrc;
+        run.settings.hrc.epsilon = epsilon;
+        runs.push_back(run);
+    }
+    if (options.directOnly) {
+        // Deterministic direct light, as fine as the finest HRC run: what ignoring
+        // scattering costs in accuracy, and what it saves in time.
+        Run run{"direct", "hrc", base};
+        run.settings.kind = SolverKind::kHrc;
+        run.settings.hrc.directOnly = true;
+        if (!options.hrcEpsilons.empty()) {
+            run.settings.hrc.epsilon =
+                *std::min_element(options.hrcEpsilons.begin(), options.hrcEpsilons.end());
+            run.setting = "epsilon=" + Number(run.settings.hrc.epsilon);
+        }
+        runs.push_back(run);
+    }
+    return runs;
+}
+
+struct Row {
+    std::string solver, setting, band;
+    SolveStats stats;
+    BandAccuracy accuracy;
+    double balancePct = 0.0;
+};
+
+void WriteCsv(const std::string& path, const std::string& scene, int leaves,
+              const std::vector<Row>& rows) {
+    if (std::filesystem::path(path).has_parent_path()) {
+        std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+    }
+    std::ofstream out(path);
+    if (!out) throw InputError(ErrorCode::kIo, path, "cannot write");
+    out << "scene,leaves,solver,setting,band,wall_s,cpu_s,peak_mib,iterations,links,"
+           "l2_pct_of_max,mean_rel_pct,p95_rel_pct,reference_floor_pct,lit_leaves,"
+           "balance_residual_pct\n";
+    for (const Row& r : rows) {
+        out << scene << ',' << leaves << ',' << r.solver << ',' << r.setting << ',' << r.band << ','
+            << Number(r.stats.wallSeconds) << ',' << Number(r.stats.cpuSeconds) << ','
+            << Number(static_cast<double>(r.stats.peakRssBytes) / (1 << 20)) << ','
+            << r.stats.iterations << ',' << r.stats.links << ',' << Number(r.accuracy.l2PctOfMax)
+            << ',' << Number(r.accuracy.meanRelativePct) << ',' << Number(r.accuracy.p95RelativePct)
+            << ',' << Number(r.accuracy.referenceFloorPct) << ',' << r.accuracy.litLeaves << ','
+            << Number(r.balancePct) << '\n';
+    }
+    if (!out) throw InputError(ErrorCode::kIo, path, "cannot write");
+}
+
+void PrintTable(const std::string& scene, const std::vector<Row>& rows) {
+    std::printf("%-12s %-6s %-16s %-5s %8s %8s %9s %8s %9s %8s %8s %9s\n", "scene", "solver",
+                "setting", "band", "wall_s", "cpu_s", "peak_MiB", "L2_%max", "mean_rel%",
+                "p95_rel%", "floor_%", "balance%");
+    for (const Row& r : rows) {
+        std::printf("%-12s %-6s %-16s %-5s %8.3f %8.3f %9.0f %8.3f %9.3f %8.3f %8.3f %9.3f\n",
+                    scene.c_str(), r.solver.c_str(), r.setting.c_str(), r.band.c_str(),
+                    r.stats.wallSeconds, r.stats.cpuSeconds,
+                    static_cast<double>(r.stats.peakRssBytes) / (1 << 20), r.accuracy.l2PctOfMax,
+                    r.accuracy.meanRelativePct, r.accuracy.p95RelativePct,
+                    r.accuracy.referenceFloorPct, r.balancePct);
+    }
+}
+
+std::vector<Row> RowsOf(const Run& run, const Scene& scene, const FlatScene& flat,
+                        const Solution& reference, const Solution& solution) {
+    const std::vector<BandAccuracy> accuracy = CompareLeaves(scene, flat, reference, solution);
+    std::vector<Row> rows;
+    for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+        rows.push_back({run.solver, run.setting, scene.bands[b].name, solution.stats, accuracy[b],
+                        100.0 * solution.balance[b].RelativeResidual()});
+    }
+    return rows;
+}
+
+// Plotting is Python's (matplotlib); a missing plot is a warning, the CSV is the result.
+void Plot(const ErrorBenchOptions& options) {
+    auto quoted = [](const std::string& text) {
+        std::string out = "'";
+        for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+        return out + "'";
+    };
+    // Debian's own Python is the one with python3-matplotlib, whatever else is on the PATH.
+    const std::string python =
+        std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+    const std::string command = python + " " + quoted(options.plotScript) + " " +
+                                quoted(options.csv) + " " + quoted(options.png);
+    if (std::system(command.c_str()) != 0) {
+        spdlog::warn("no plot: `{}` failed (python3 with matplotlib is needed)", command);
+    }
+}
+
+}  // namespace
+
+std::string DefaultCacheDirectory() {
+    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) {
+        return std::string(xdg) + "/leaflux";
+    }
+    if (const char* home = std::getenv("HOME"); home && *home) {
+        return std::string(home) + "/.cache/leaflux";
+    }
+    return ".leaflux-cache";
+}
+
+int RunErrorBench(const ErrorBenchOptions& options) {
+    const Scene scene = LoadSceneFile(options.scene);
+    const std::string& name = options.name;
+    PreparedScene prepared(scene);
+    const FlatScene& flat = prepared.Flat();
+    int leaves = 0;
+    for (const Node& node : scene.nodes) leaves += node.type == NodeType::kLeaf;
+    if (!ResetPeakRss()) {
+        spdlog::warn(
+            "the kernel does not let the peak memory be reset: each run's peak is the "
+            "process's so far");
+    }
+
+    SolverSettings referenceSettings;
+    referenceSettings.kind = SolverKind::kMonteCarlo;
+    referenceSettings.monteCarlo.samplesPerReceiver = options.referenceSamples;
+    referenceSettings.monteCarlo.seed = options.referenceSeed;
+    referenceSettings.monteCarlo.threads = options.threads;
+    const std::filesystem::path cached =
+        std::filesystem::path(options.cacheDirectory.empty() ? DefaultCacheDirectory()
+                                                             : options.cacheDirectory) /
+        ("reference-" + ReferenceKey(scene, referenceSettings.monteCarlo) + ".bin");
+    // A first solve pays the process's one-time start-up (worker threads, first touches of
+    // the ray engine): a minimal untimed solve keeps it out of the timings, as a daemon
+    // pays it once in its life.
+    SolverSettings warmUp = referenceSettings;
+    warmUp.monteCarlo.samplesPerReceiver = warmUp.monteCarlo.replicates = 2;
+    Solve(prepared, warmUp);
+
+    std::optional<Solution> reference =
+        ReadCachedReference(cached, flat.receivers.size(), scene.bands.size());
+    if (reference) {
+        spdlog::info("{}: {} leaves; reference from {} (solved in {:.1f} s)", name, leaves,
+                     cached.string(), reference->stats.wallSeconds);
+    } else {
+        spdlog::info("{}: {} leaves; solving the reference at {} paths per receiver", name, leaves,
+                     options.referenceSamples);
+        reference = Solve(prepared, referenceSettings);
+        WriteCachedReference(cached, *reference);
+        spdlog::info("reference solved in {:.1f} s, cached in {}", reference->stats.wallSeconds,
+                     cached.string());
+    }
+
+    // The reference against itself: its own error is its standard error (the floor).
+    std::vector<Row> rows =
+        RowsOf({"mc", "reference samples=" + std::to_string(options.referenceSamples), {}}, scene,
+               flat, *reference, *reference);
+    for (const Run& run : Runs(options)) {
+        ResetPeakRss();
+        const Solution solution = Solve(prepared, run.settings);
+        spdlog::info("{} {}: {:.2f} s", run.solver, run.setting, solution.stats.wallSeconds);
+        for (Row& row : RowsOf(run, scene, flat, *reference, solution)) rows.push_back(row);
+    }
+    WriteCsv(options.csv, name, leaves, rows);
+    PrintTable(name, rows);
+    std::cout << "wrote " << options.csv << std::endl;
+    if (!options.png.empty()) Plot(options);
+    return 0;
+}
+
+}  // namespace leaflux

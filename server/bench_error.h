@@ -1,0 +1,36 @@
+// `leaflux bench error`: error against run time on one scene. The Monte Carlo reference at
+// a high sample count (cached on disk, keyed by the scene and its settings), then every
+// solver at a list of settings, each compared with the reference per band (accuracy.h),
+// with its wall time, CPU time and peak memory. Writes a CSV, prints the table and plots
+// error against time with matplotlib when Python has it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace leaflux {
+
+struct ErrorBenchOptions {
+    std::string scene;       // scene file
+    std::string name;        // the scene's name in the CSV and the log
+    std::string csv;         // where to write the rows
+    std::string png;         // where to plot them (none when empty)
+    std::string plotScript;  // the Python script that plots (examples/plot_error.py)
+    std::string cacheDirectory;
+    int referenceSamples = 8192;
+    std::uint64_t referenceSeed = 99;
+    std::vector<int> monteCarloSamples{64, 256, 1024};
+    std::vector<double> hrcEpsilons{1e-3, 1e-4, 1e-5};
+    bool directOnly = true;  // also direct light only (HRC, the finest ε)
+    int threads = 0;
+};
+
+// The directory references are cached in when none is given: $XDG_CACHE_HOME/leaflux,
+// else ~/.cache/leaflux, else ./.leaflux-cache.
+std::string DefaultCacheDirectory();
+
+// Runs the benchmark; returns the process exit code.
+int RunErrorBench(const ErrorBenchOptions& options);
+
+}  // namespace leaflux

@@ -1,0 +1,80 @@
+#include "solver/accuracy.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_set>
+
+#include "solver/check.h"
+
+namespace leaflux {
+namespace {
+
+std::vector<std::size_t> LeafReceivers(const Scene& scene, const FlatScene& flat) {
+    std::unordered_set<NodeId> leaves;
+    for (const Node& node : scene.nodes) {
+        if (node.type == NodeType::kLeaf) leaves.insert(node.id);
+    }
+    std::vector<std::size_t> receivers;
+    for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
+        const Receiver& receiver = flat.receivers[r];
+        if (receiver.kind == ReceiverKind::kOrgan && leaves.count(receiver.node)) {
+            receivers.push_back(r);
+        }
+    }
+    return receivers;
+}
+
+double BothSides(const BandLight& light) {
+    return light.irradianceUpperWm2 + light.irradianceLowerWm2;
+}
+
+}  // namespace
+
+std::vector<BandAccuracy> CompareLeaves(const Scene& scene, const FlatScene& flat,
+                                        const Solution& reference, const Solution& value) {
+    LEAFLUX_CHECK_EQ(reference.light.size(), flat.receivers.size());
+    LEAFLUX_CHECK_EQ(value.light.size(), flat.receivers.size());
+    const std::vector<std::size_t> leaves = LeafReceivers(scene, flat);
+    std::vector<BandAccuracy> bands(scene.bands.size());
+    for (std::size_t b = 0; b < bands.size(); ++b) {
+        BandAccuracy& accuracy = bands[b];
+        accuracy.leaves = static_cast<int>(leaves.size());
+        for (std::size_t r : leaves) {
+            accuracy.referenceMaxWm2 =
+                std::max(accuracy.referenceMaxWm2, BothSides(reference.light[r][b]));
+        }
+        if (accuracy.referenceMaxWm2 <= 0.0) continue;
+        double squaredError = 0.0, squaredStderr = 0.0;
+        std::vector<double> relative;
+        for (std::size_t r : leaves) {
+            const BandLight& truth = reference.light[r][b];
+            const double expected = BothSides(truth);
+            const double error = BothSides(value.light[r][b]) - expected;
+            squaredError += error * error;
+            if (truth.stderrUpperWm2 >= 0.0 && truth.stderrLowerWm2 >= 0.0) {
+                squaredStderr += truth.stderrUpperWm2 * truth.stderrUpperWm2 +
+                                 truth.stderrLowerWm2 * truth.stderrLowerWm2;
+            }
+            if (expected >= BandAccuracy::kLitFraction * accuracy.referenceMaxWm2) {
+                relative.push_back(std::abs(error) / expected);
+            }
+        }
+        const double n = static_cast<double>(leaves.size());
+        accuracy.l2PctOfMax = 100.0 * std::sqrt(squaredError / n) / accuracy.referenceMaxWm2;
+        accuracy.referenceFloorPct =
+            100.0 * std::sqrt(squaredStderr / n) / accuracy.referenceMaxWm2;
+        accuracy.litLeaves = static_cast<int>(relative.size());
+        double sum = 0.0;
+        for (double e : relative) sum += e;
+        accuracy.meanRelativePct = 100.0 * sum / static_cast<double>(relative.size());
+        // The 95th percentile: the value 95 % of the lit leaves stay at or below.
+        const std::size_t rank =
+            std::min(relative.size() - 1, static_cast<std::size_t>(0.95 * relative.size()));
+        const auto p95 = relative.begin() + static_cast<std::ptrdiff_t>(rank);
+        std::nth_element(relative.begin(), p95, relative.end());
+        accuracy.p95RelativePct = 100.0 * *p95;
+    }
+    return bands;
+}
+
+}  // namespace leaflux
