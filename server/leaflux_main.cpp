@@ -83,11 +83,13 @@ int RunSolve(const SolveCommand& command) {
 struct GenerateCommand {
     TreeParameters tree;
     int rows = 1, columns = 1;
-    double spacing = 6.0, rowAzimuth = 0.0, sunElevation = 50.0, sunAzimuth = 160.0;
+    double spacing = 6.0, rowSpacing = 0.0, rowAzimuth = 0.0, sunElevation = 50.0, sunAzimuth = 160.0;
     double sunPar = 400.0, sunNir = 350.0, skyPar = 100.0, skyNir = 60.0;
     bool noSky = false;
     CanopyParameters canopy;
     bool randomCanopy = false;
+    bool greenhouse = false;
+    double lampPar = 1500.0, lampNir = 150.0;
     std::string skyCones = "continuous";
     std::string out;
 };
@@ -111,22 +113,32 @@ int RunGenerate(const GenerateCommand& command) {
     plantation.tree = command.tree;
     plantation.rows = command.rows;
     plantation.columns = command.columns;
-    plantation.rowSpacingM = plantation.columnSpacingM = command.spacing;
+    plantation.columnSpacingM = command.spacing;
+    plantation.rowSpacingM = command.rowSpacing > 0.0 ? command.rowSpacing : command.spacing;
     plantation.rowAzimuthDeg = command.rowAzimuth;
     plantation.jitterM = 0.1 * command.spacing;
     if (command.randomCanopy) {
         CanopyParameters canopy = command.canopy;
         canopy.seed = command.tree.seed;
         AddRandomCanopy(scene, canopy);
+    } else if (command.greenhouse) {
+        scene.optics.push_back({"wall", {{0.80, 0.80, 0.0, 0.0}, {0.85, 0.85, 0.0, 0.0}}});
+        scene.optics.push_back({"floor", {{0.60, 0.60, 0.0, 0.0}, {0.70, 0.70, 0.0, 0.0}}});
+        GreenhouseParameters greenhouse;
+        greenhouse.plantation = plantation;
+        greenhouse.lampExitanceWm2 = {command.lampPar, command.lampNir};
+        AddGreenhouse(scene, greenhouse);
     } else {
         AddPlantation(scene, plantation, "ground");
     }
     const double h = glm::radians(command.sunElevation), a = glm::radians(command.sunAzimuth);
-    scene.sources.suns.push_back(
-        {{std::cos(h) * std::sin(a), std::cos(h) * std::cos(a), std::sin(h)},
-         {command.sunPar, command.sunNir},
-         0.0});
-    if (!command.noSky) {
+    if (!command.greenhouse) {
+        scene.sources.suns.push_back(
+            {{std::cos(h) * std::sin(a), std::cos(h) * std::cos(a), std::sin(h)},
+             {command.sunPar, command.sunNir},
+             0.0});
+    }
+    if (!command.noSky && !command.greenhouse) {
         scene.sources.skies.push_back({SkyModel::kCieOvercast,
                                        {command.skyPar, command.skyNir},
                                        SkyDiscretizationNamed(command.skyCones)});
@@ -280,6 +292,10 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 1000));
     generateApp->add_option("--spacing", generate.spacing, "Distance between trees (m)")
         ->check(CLI::PositiveNumber);
+    generateApp
+        ->add_option("--row-spacing", generate.rowSpacing,
+                     "Distance between rows (m; default: --spacing, the distance along a row)")
+        ->check(CLI::PositiveNumber);
     generateApp->add_option("--row-azimuth", generate.rowAzimuth,
                             "Row direction from north, clockwise (deg)");
     generateApp->add_option("--sun-elevation", generate.sunElevation, "Sun elevation (deg)")
@@ -289,6 +305,15 @@ int main(int argc, char** argv) {
     generateApp->add_flag("--no-sky", generate.noSky, "Sun only, no diffuse sky");
     generateApp->add_flag("--random-canopy", generate.randomCanopy,
                           "A random canopy of square leaves (spherical angles) instead of trees");
+    generateApp->add_flag(
+        "--greenhouse", generate.greenhouse,
+        "A greenhouse at night instead: the rows of trees (small plants, see --leaves, "
+        "--leaf-length, --spacing) on a white floor, white walls, no roof, a bar of lamps "
+        "2.4 m above each row; no sun, no sky");
+    generateApp->add_option("--lamp-par", generate.lampPar, "Greenhouse: lamp exitance, PAR (W/m²)")
+        ->check(CLI::NonNegativeNumber);
+    generateApp->add_option("--lamp-nir", generate.lampNir, "Greenhouse: lamp exitance, NIR (W/m²)")
+        ->check(CLI::NonNegativeNumber);
     generateApp->add_option("--canopy-leaves", generate.canopy.leaves, "Random canopy: leaves")
         ->check(CLI::Range(1, 10'000'000));
     generateApp

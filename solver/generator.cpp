@@ -216,14 +216,46 @@ NodeId AddTree(Scene& scene, const TreeParameters& parameters, const glm::dvec3&
     return TreeBuilder(scene, parameters, firstId).Build(base);
 }
 
+namespace {
+
+// The plantation's axes and extent: `along` the rows, `across` them; a point (u, v, z) of
+// the unit square [−1, 1]² maps to the corners of the ground the trees stand on.
+struct PlantationFrame {
+    glm::dvec3 along, across;
+    double halfAlong, halfAcross;
+
+    explicit PlantationFrame(const PlantationParameters& p) {
+        const double azimuth = glm::radians(p.rowAzimuthDeg);
+        along = {std::sin(azimuth), std::cos(azimuth), 0.0};
+        across = {along.y, -along.x, 0.0};
+        halfAlong = 0.5 * p.columns * p.columnSpacingM + p.jitterM;
+        halfAcross = 0.5 * p.rows * p.rowSpacingM + p.jitterM;
+    }
+    glm::dvec3 At(const glm::dvec3& unit) const {
+        return unit.x * halfAlong * along + unit.y * halfAcross * across +
+               glm::dvec3(0, 0, unit.z);
+    }
+};
+
+// The planar quad a b c d (in order round it) with its upper side towards `facing`.
+std::shared_ptr<Mesh> QuadFacing(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d,
+                                 const glm::dvec3& facing) {
+    auto mesh = std::make_shared<Mesh>();
+    mesh->positions = {a, b, c, d};
+    mesh->triangles = glm::dot(glm::cross(b - a, c - a), facing) > 0.0
+                          ? std::vector<glm::uvec3>{{0, 1, 2}, {0, 2, 3}}
+                          : std::vector<glm::uvec3>{{0, 2, 1}, {0, 3, 2}};
+    return mesh;
+}
+
+}  // namespace
+
 void AddPlantation(Scene& scene, const PlantationParameters& parameters,
                    const std::string& groundOptics) {
     if (parameters.rows < 1 || parameters.columns < 1) {
         throw InputError(ErrorCode::kInvalidArgument, "rows", "needs at least one row and column");
     }
-    const double azimuth = glm::radians(parameters.rowAzimuthDeg);
-    const glm::dvec3 along(std::sin(azimuth), std::cos(azimuth), 0.0);
-    const glm::dvec3 across(along.y, -along.x, 0.0);
+    const PlantationFrame frame(parameters);
     NodeId next = 1;
     for (const Node& node : scene.nodes) next = std::max(next, node.id + 1);
     Random jitter(StreamSeed(parameters.tree.seed, 0xB0A7));
@@ -235,23 +267,49 @@ void AddPlantation(Scene& scene, const PlantationParameters& parameters,
                              parameters.jitterM * (2.0 * jitter.Uniform() - 1.0);
             TreeParameters tree = parameters.tree;
             tree.seed = StreamSeed(parameters.tree.seed, r, c);
-            next = AddTree(scene, tree, x * along + y * across, next);
+            next = AddTree(scene, tree, x * frame.along + y * frame.across, next);
         }
     }
     if (groundOptics.empty()) return;
-    const double halfX = 0.5 * parameters.columns * parameters.columnSpacingM + parameters.jitterM;
-    const double halfY = 0.5 * parameters.rows * parameters.rowSpacingM + parameters.jitterM;
-    auto ground = std::make_shared<Mesh>();
-    for (const auto& [u, v] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
-        ground->positions.push_back(u * halfX * along + v * halfY * across);
+    const glm::dvec3 a = frame.At({-1, -1, 0}), b = frame.At({1, -1, 0}),
+                     c = frame.At({1, 1, 0}), d = frame.At({-1, 1, 0});
+    scene.environment.push_back({"ground", QuadFacing(a, b, c, d, {0, 0, 1}), groundOptics});
+}
+
+void AddGreenhouse(Scene& scene, const GreenhouseParameters& p) {
+    if (!(p.wallHeightM > 0.0) || !(p.lampHeightM > 0.0) || !(p.lampHeightM <= p.wallHeightM) ||
+        !(p.lampWidthM > 0.0)) {
+        throw InputError(ErrorCode::kInvalidArgument, "greenhouse",
+                         "needs 0 < lamp height <= wall height and a positive lamp width");
     }
-    // Upper side up whatever the rows' azimuth.
-    ground->triangles = glm::dot(glm::cross(ground->positions[1] - ground->positions[0],
-                                            ground->positions[2] - ground->positions[0]),
-                                 glm::dvec3(0, 0, 1)) > 0.0
-                            ? std::vector<glm::uvec3>{{0, 1, 2}, {0, 2, 3}}
-                            : std::vector<glm::uvec3>{{0, 2, 1}, {0, 3, 2}};
-    scene.environment.push_back({"ground", ground, groundOptics});
+    if (p.lampExitanceWm2.size() != scene.bands.size()) {
+        throw InputError(ErrorCode::kInvalidArgument, "greenhouse.lamp_exitance",
+                         "needs one exitance per band");
+    }
+    AddPlantation(scene, p.plantation, p.floorOptics);
+    const PlantationFrame frame(p.plantation);
+    const glm::dvec3 corners[4] = {{-1, -1, 0}, {-1, 1, 0}, {1, 1, 0}, {1, -1, 0}};
+    const glm::dvec3 up(0, 0, p.wallHeightM);
+    for (int w = 0; w < 4; ++w) {
+        const glm::dvec3 a = frame.At(corners[w]), b = frame.At(corners[(w + 1) % 4]);
+        scene.environment.push_back({"wall" + std::to_string(w),
+                                     QuadFacing(a, a + up, b + up, b, -(a + b)),  // inwards
+                                     p.wallOptics});
+    }
+    // Rows run along `along`, at the plantation's row positions across.
+    const PlantationParameters& plantation = p.plantation;
+    const double halfLength = 0.4 * plantation.columns * plantation.columnSpacingM;
+    for (int r = 0; r < plantation.rows; ++r) {
+        const double y = (r - 0.5 * (plantation.rows - 1)) * plantation.rowSpacingM;
+        auto corner = [&](double u, double v) {
+            return u * halfLength * frame.along + (y + 0.5 * v * p.lampWidthM) * frame.across +
+                   glm::dvec3(0, 0, p.lampHeightM);
+        };
+        auto lamp = QuadFacing(corner(-1, -1), corner(-1, 1), corner(1, 1), corner(1, -1),
+                               {0, 0, -1});
+        scene.sources.emitters.push_back(
+            {"lamp" + std::to_string(r), std::move(lamp), p.lampExitanceWm2, ""});
+    }
 }
 
 void AddRandomCanopy(Scene& scene, const CanopyParameters& p) {

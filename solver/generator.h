@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "solver/scene.h"
 
@@ -48,6 +49,22 @@ struct PlantationParameters {
 // when empty). Returns the scene's bands and optics untouched: the caller declares them.
 void AddPlantation(Scene& scene, const PlantationParameters& parameters,
                    const std::string& groundOptics);
+
+// A greenhouse compartment at night: a plantation of small plants on a floor (optics
+// `floorOptics`), four walls (`wallOptics`, upper sides facing in) of the floor's extent
+// and `wallHeightM` high, no roof (a glass roof lets scattered light out), and above each
+// row a bar of lamps facing down: 80 % of the row's length, `lampWidthM` wide, at
+// `lampHeightM`, emitting `lampExitanceWm2` per band (black: they absorb what they get).
+struct GreenhouseParameters {
+    PlantationParameters plantation;
+    double wallHeightM = 3.0;
+    double lampHeightM = 2.4;
+    double lampWidthM = 0.15;
+    std::vector<double> lampExitanceWm2;  // per band of the scene
+    std::string floorOptics = "floor";
+    std::string wallOptics = "wall";
+};
+void AddGreenhouse(Scene& scene, const GreenhouseParameters& parameters);
 
 // A random canopy: square leaves of spherical angle distribution (normals uniform on the
 // sphere), centres uniform over a width × width square and between two heights, sized for
