@@ -83,7 +83,8 @@ int RunSolve(const SolveCommand& command) {
 struct GenerateCommand {
     TreeParameters tree;
     int rows = 1, columns = 1;
-    double spacing = 6.0, rowSpacing = 0.0, rowAzimuth = 0.0, sunElevation = 50.0, sunAzimuth = 160.0;
+    double spacing = 6.0, rowSpacing = 0.0, rowAzimuth = 0.0, sunElevation = 50.0,
+           sunAzimuth = 160.0;
     double sunPar = 400.0, sunNir = 350.0, skyPar = 100.0, skyNir = 60.0;
     bool noSky = false;
     CanopyParameters canopy;

@@ -232,8 +232,7 @@ struct PlantationFrame {
         halfAcross = 0.5 * p.rows * p.rowSpacingM + p.jitterM;
     }
     glm::dvec3 At(const glm::dvec3& unit) const {
-        return unit.x * halfAlong * along + unit.y * halfAcross * across +
-               glm::dvec3(0, 0, unit.z);
+        return unit.x * halfAlong * along + unit.y * halfAcross * across + glm::dvec3(0, 0, unit.z);
     }
 };
 
@@ -271,8 +270,8 @@ void AddPlantation(Scene& scene, const PlantationParameters& parameters,
         }
     }
     if (groundOptics.empty()) return;
-    const glm::dvec3 a = frame.At({-1, -1, 0}), b = frame.At({1, -1, 0}),
-                     c = frame.At({1, 1, 0}), d = frame.At({-1, 1, 0});
+    const glm::dvec3 a = frame.At({-1, -1, 0}), b = frame.At({1, -1, 0}), c = frame.At({1, 1, 0}),
+                     d = frame.At({-1, 1, 0});
     scene.environment.push_back({"ground", QuadFacing(a, b, c, d, {0, 0, 1}), groundOptics});
 }
 
@@ -305,8 +304,8 @@ void AddGreenhouse(Scene& scene, const GreenhouseParameters& p) {
             return u * halfLength * frame.along + (y + 0.5 * v * p.lampWidthM) * frame.across +
                    glm::dvec3(0, 0, p.lampHeightM);
         };
-        auto lamp = QuadFacing(corner(-1, -1), corner(-1, 1), corner(1, 1), corner(1, -1),
-                               {0, 0, -1});
+        auto lamp =
+            QuadFacing(corner(-1, -1), corner(-1, 1), corner(1, 1), corner(1, -1), {0, 0, -1});
         scene.sources.emitters.push_back(
             {"lamp" + std::to_string(r), std::move(lamp), p.lampExitanceWm2, ""});
     }

@@ -44,6 +44,51 @@ TEST(HrcPlate, UnderDiscretisedSkyKeepsTheHorizontalIrradiance) {
     EXPECT_NEAR(s.light[0][0].irradianceUpperWm2, 300.0, 0.02 * 300.0);
 }
 
+// Stems as importers give them: a strip is lit on both sides (as by the reference's rays);
+// the faces of a tube, open at both ends, on their outer sides only.
+TEST(HrcStem, AStripIsLitOnBothSidesAndATubeOnlyOutside) {
+    Scene scene = OneBandScene({{"stem", Opaque(0.0)}});
+    auto internode = [&](NodeId id, const std::string& name, std::shared_ptr<const Mesh> mesh) {
+        Node node = OrganNode(id, name, std::move(mesh), "stem");
+        node.type = NodeType::kInternode;
+        scene.nodes.push_back(node);
+    };
+    // A strip facing east (+x) at x = 0, and a 10 cm square tube 1 m south of it.
+    internode(1, "strip", Quad({0, -0.05, 0}, {0, 0.05, 0}, {0, 0.05, 1}, {0, -0.05, 1}));
+    auto tube = std::make_shared<Mesh>();
+    for (double z : {0.0, 1.0}) {
+        for (auto [x, y] :
+             {std::pair{-0.05, -1.05}, {0.05, -1.05}, {0.05, -0.95}, {-0.05, -0.95}}) {
+            tube->positions.push_back({x, y, z});
+        }
+    }
+    for (unsigned i = 0; i < 4; ++i) {  // counter-clockwise seen from outside
+        const unsigned j = (i + 1) % 4;
+        tube->triangles.push_back({i, j, j + 4});
+        tube->triangles.push_back({i, j + 4, i + 4});
+    }
+    internode(2, "tube", tube);
+    scene.sources.suns.push_back(SunAt(30, 90, 1000));  // from the east
+    scene.sources.suns.push_back(SunAt(30, 0, 1000));   // from the north: grazes the strip
+    scene.Validate();
+    const PreparedScene prepared(scene);
+    const Solution s = SolveWithHrc(prepared, 1e-4);
+    // The strip: the east sun on its upper side; nothing on its lower side, which the
+    // north sun only grazes.
+    EXPECT_NEAR(s.light[0][0].irradianceUpperWm2, 1000 * std::cos(glm::radians(30.0)), 1e-6);
+    EXPECT_NEAR(s.light[0][0].irradianceLowerWm2, 0.0, 1e-6);
+    // The tube: east and north faces lit outside (cos 30° each, a quarter of the area),
+    // nothing inside.
+    EXPECT_NEAR(s.light[1][0].irradianceUpperWm2, 0.5 * 1000 * std::cos(glm::radians(30.0)), 1e-6);
+    EXPECT_EQ(s.light[1][0].irradianceLowerWm2, 0.0);
+
+    // Turned round, the strip faces west: the east sun now lights its lower side.
+    scene.nodes[0].organ->mesh = Quad({0, 0.05, 0}, {0, -0.05, 0}, {0, -0.05, 1}, {0, 0.05, 1});
+    const PreparedScene turned(scene);
+    const Solution t = SolveWithHrc(turned, 1e-4);
+    EXPECT_NEAR(t.light[0][0].irradianceLowerWm2, 1000 * std::cos(glm::radians(30.0)), 1e-6);
+}
+
 struct ViewFactorCase {
     const char* name;
     std::shared_ptr<const Mesh> emitter, receiver;

@@ -139,15 +139,8 @@ class HrcSolver {
           directions_(DirectionSet::OfLevel(options.directionLevel)),
           bands_(static_cast<int>(scene.bands.size())),
           bins_(directions_.Size()) {
-        std::unordered_map<NodeId, NodeType> types;
-        for (const Node& node : scene.nodes) types[node.id] = node.type;
-        for (const Receiver& receiver : flat.receivers) {
-            optics_.push_back(OpticsOf(receiver));
-            // Internodes and fruits are solids: light reaches their outer (upper) side only.
-            const bool organ = receiver.kind == ReceiverKind::kOrgan;
-            const NodeType type = organ ? types.at(receiver.node) : NodeType::kOther;
-            solid_.push_back(type == NodeType::kInternode || type == NodeType::kFruit);
-        }
+        for (const Receiver& receiver : flat.receivers) optics_.push_back(OpticsOf(receiver));
+        FindInnerSides(scene);
         for (const Sun& sun : scene.sources.suns) AddSource(sun.towardSun, sun.normalIrradianceWm2);
         for (const Sky& sky : scene.sources.skies) {
             Sky discrete = sky;
@@ -233,13 +226,41 @@ class HrcSolver {
         return total;
     }
 
+    // Internodes and fruits are solids, drawn closed or as open tubes: a side of their
+    // triangles that faces the organ's own surface is inside and gets no light. The
+    // reference's rays find the same; a side facing out (a stem drawn as a strip, a tube
+    // wound inwards) is lit as any surface.
+    void FindInnerSides(const Scene& scene) {
+        std::unordered_map<NodeId, NodeType> types;
+        for (const Node& node : scene.nodes) types[node.id] = node.type;
+        inner_.assign(flat_.triangles.size(), 0);
+        for (const Receiver& receiver : flat_.receivers) {
+            if (receiver.kind != ReceiverKind::kOrgan) continue;
+            const NodeType type = types.at(receiver.node);
+            if (type != NodeType::kInternode && type != NodeType::kFruit) continue;
+            for (std::uint32_t t = receiver.firstTriangle;
+                 t < receiver.firstTriangle + receiver.triangleCount; ++t) {
+                const Triangle& tri = flat_.triangles[t];
+                for (int side : {kUpper, kLower}) {
+                    const RayHit hit = rays_.Trace({(tri.a + tri.b + tri.c) / 3.0, t},
+                                                   side == kUpper ? tri.normal : -tri.normal);
+                    if (hit.fate == RayFate::kHit &&
+                        flat_.triangles[hit.triangle].receiver == tri.receiver) {
+                        inner_[t] |= 1 << side;
+                    }
+                }
+            }
+        }
+    }
+
+    bool Inner(std::uint32_t triangle, int side) const { return inner_[triangle] >> side & 1; }
+
     // How much a receiving point of normal n on a triangle takes of light from ω: |n · ω|,
     // but nothing on the inner side of a solid.
     double ReceivingWeight(std::uint32_t triangle, const glm::dvec3& n,
                            const glm::dvec3& omega) const {
         const double cosine = glm::dot(n, omega);
-        if (cosine < 0.0 && solid_[flat_.triangles[triangle].receiver]) return 0.0;
-        return std::abs(cosine);
+        return Inner(triangle, cosine > 0.0 ? kUpper : kLower) ? 0.0 : std::abs(cosine);
     }
 
     // The unoccluded fraction of the light from s that r's points take, from stratified
@@ -569,7 +590,7 @@ class HrcSolver {
     const int bands_;
     const int bins_;
     std::vector<SideOptics> optics_;
-    std::vector<bool> solid_;  // by receiver
+    std::vector<std::uint8_t> inner_;  // by flat triangle: bit s set when side s is inside
     std::vector<DirectionalSource> sources_;
     double totalPower_ = 0.0;
     std::int64_t rayCount_ = 0;
@@ -825,11 +846,10 @@ void HrcSolver<kBands>::PushSubtree(std::uint32_t start, const Level& above, boo
         Sided e = level.sides;
         Spectrum integral = level.integral;
         auto moment = level.moment;
-        const bool solid = solid_[node.receiver];
         for (int d = 0; d < bins_; ++d) {
             const glm::dvec3& omega = directions_.Direction(d);
             const double cosine = glm::dot(node.normal, omega);
-            if (solid && cosine < 0.0) continue;
+            if (Inner(node.triangle, cosine > 0.0 ? kUpper : kLower)) continue;
             for (int k = 0; k < bands_; ++k) {
                 const double normal = level.bins[d * bands_ + k];
                 e[cosine > 0.0 ? kUpper : kLower][k] += normal * std::abs(cosine);
@@ -840,7 +860,7 @@ void HrcSolver<kBands>::PushSubtree(std::uint32_t start, const Level& above, boo
         for (std::size_t s = 0; s < sources_.size(); ++s) {
             if (level.sources[s] <= 0.0) continue;
             const double cosine = glm::dot(node.normal, sources_[s].toward);
-            if (solid && cosine < 0.0) continue;
+            if (Inner(node.triangle, cosine > 0.0 ? kUpper : kLower)) continue;
             for (int k = 0; k < bands_; ++k) {
                 const double normal = sources_[s].normalIrradiance[k] * level.sources[s];
                 e[cosine > 0.0 ? kUpper : kLower][k] += normal * std::abs(cosine);
