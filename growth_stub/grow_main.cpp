@@ -19,7 +19,9 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     app.add_option("--cycles", cycles, "Growth cycles (default: the scenario's)")
         ->check(CLI::Range(1, 100000));
-    app.add_option("--out", options.outDir, "Output folder: cycles.csv, plants.csv, cycle<N>.ply");
+    app.add_option("--out", options.outDir,
+                   "Output folder: cycles.csv, plants.csv, phytomers.csv (organ masses by "
+                   "topological address), cycle<N>.ply");
     app.add_option("--ply-cycles", pictures, "Cycles whose PLY is written, e.g. 2,9,13,17,25");
     app.add_option("--endpoint", endpoint, "leafluxd's address");
     app.add_option("--curve-server-key", curveKeyFile,

@@ -456,6 +456,31 @@ std::vector<PlantSummary> GrowthModel::Summaries() const {
     return out;
 }
 
+std::vector<GrowthModel::PhytomerSize> GrowthModel::Phytomers() const {
+    std::vector<PhytomerSize> out;
+    for (const Plant& plant : plants_) {
+        // Axes are made after their bearer's, so a bearer's address is known first.
+        std::vector<std::string> axisAddress(plant.axes.size());
+        std::vector<int> rank(plant.phytomers.size());
+        for (std::size_t a = 0; a < plant.axes.size(); ++a) {
+            const Axis& axis = plant.axes[a];
+            axisAddress[a] = axis.bearer < 0 ? "0"
+                                             : axisAddress[plant.phytomers[axis.bearer].axis] +
+                                                   "." + std::to_string(rank[axis.bearer]);
+            for (std::size_t r = 0; r < axis.phytomers.size(); ++r) {
+                rank[axis.phytomers[r]] = static_cast<int>(r);
+            }
+        }
+        for (std::size_t i = 0; i < plant.phytomers.size(); ++i) {
+            const Phytomer& p = plant.phytomers[i];
+            out.push_back({std::to_string(plant.id) + ":" + axisAddress[p.axis] + "/" +
+                               std::to_string(rank[i]),
+                           p.internodeG, p.leaf != 0 ? p.leafG : 0.0});
+        }
+    }
+    return out;
+}
+
 std::vector<GrowthModel::LeafInfo> GrowthModel::Leaves() const {
     std::vector<LeafInfo> out;
     for (const Plant& plant : plants_) {

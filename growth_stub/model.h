@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <map>
+#include <string>
 #include <vector>
 
 #include "scenario.pb.h"
@@ -85,6 +86,16 @@ class GrowthModel {
         double areaM2 = 0.0;
     };
     std::vector<LeafInfo> Leaves() const;
+    // Every phytomer by its topological address, the same in two runs of one scenario
+    // however their ids differ: "<plant>:<axis>/<rank>", the main axis "0", a branch its
+    // bearer's axis and rank ("0.3" grew from the 4th phytomer of the main axis), rank
+    // from 0 at the base. For comparing plants grown under other light (paper Fig. 15).
+    struct PhytomerSize {
+        std::string address;
+        double internodeG = 0.0;
+        double leafG = 0.0;  // 0 once the leaf has fallen
+    };
+    std::vector<PhytomerSize> Phytomers() const;
     // Every plant triangle, for pictures.
     std::vector<WorldTriangle> Triangles() const;
 

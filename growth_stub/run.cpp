@@ -147,15 +147,17 @@ std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
     open.set_species(scenario.name());
     const std::string session = client.Open(open);
 
-    std::ofstream cyclesCsv, plantsCsv;
+    std::ofstream cyclesCsv, plantsCsv, phytomersCsv;
     if (!options.outDir.empty()) {
         std::filesystem::create_directories(options.outDir);
         cyclesCsv.open(options.outDir + "/cycles.csv");
         plantsCsv.open(options.outDir + "/plants.csv");
+        phytomersCsv.open(options.outDir + "/phytomers.csv");
         cyclesCsv << "cycle,leaves,leaf_area_m2,biomass_g,absorbed_par_w,added,updated,removed,"
                      "solve_s,round_trip_s,daemon_peak_mib\n";
         plantsCsv << "cycle,plant,leaves,leaf_area_m2,biomass_g,absorbed_par_w,centroid_x,"
                      "centroid_y,centroid_z\n";
+        phytomersCsv << "cycle,address,internode_g,leaf_g\n";
     }
     std::vector<CycleRecord> records;
     std::map<NodeId, v1::Node> sent;
@@ -219,6 +221,10 @@ std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
                           << ',' << plant.biomassG << ',' << plant.absorbedParW << ','
                           << plant.leafCentroid.x << ',' << plant.leafCentroid.y << ','
                           << plant.leafCentroid.z << '\n';
+            }
+            for (const GrowthModel::PhytomerSize& p : model.Phytomers()) {
+                phytomersCsv << c << ',' << p.address << ',' << p.internodeG << ',' << p.leafG
+                             << '\n';
             }
             if (options.plyCycles.count(c)) {
                 WritePly(options.outDir + "/cycle" + std::to_string(c) + ".ply", scenario, model,

@@ -2,6 +2,8 @@
 // only deltas travel, every leaf gets its light, and light shapes the plants.
 #include <gtest/gtest.h>
 
+#include <map>
+#include <set>
 #include <stdexcept>
 
 #include "growth_stub/run.h"
@@ -95,6 +97,31 @@ TEST_F(GrowthOnLoopback, ScatteredLightMakesAPlantInARoomGrowMore) {
     grow::GrowthModel direct(scenario);
     const double directArea = Grow(scenario, 10, direct).back().leafAreaM2;
     EXPECT_GT(fullArea, 1.05 * directArea) << "full " << fullArea << ", direct " << directArea;
+}
+
+// Phytomers are matched across runs by their topological address: each is unique, each
+// branch hangs from a phytomer that exists, and ranks along an axis count from the base.
+TEST_F(GrowthOnLoopback, PhytomerAddressesNameTheTopology) {
+    const grow::Scenario scenario = Scenario("open-field");
+    grow::GrowthModel model(scenario);
+    Grow(scenario, 12, model);
+    std::set<std::string> addresses;
+    std::map<std::string, int> phytomersOnAxis;
+    for (const grow::GrowthModel::PhytomerSize& p : model.Phytomers()) {
+        EXPECT_TRUE(addresses.insert(p.address).second) << p.address << " twice";
+        const std::string axis = p.address.substr(0, p.address.find('/'));
+        EXPECT_EQ(std::stoi(p.address.substr(p.address.find('/') + 1)), phytomersOnAxis[axis]++)
+            << p.address;
+    }
+    int branches = 0;
+    for (const auto& [axis, count] : phytomersOnAxis) {
+        const std::size_t dot = axis.rfind('.');
+        if (dot == std::string::npos) continue;
+        ++branches;
+        const std::string bearer = axis.substr(0, dot) + "/" + axis.substr(dot + 1);
+        EXPECT_TRUE(addresses.count(bearer)) << axis << " hangs from " << bearer;
+    }
+    EXPECT_GT(branches, 0) << "12 cycles in the open should break some buds";
 }
 
 TEST_F(GrowthOnLoopback, BranchLevelLightIsEnoughToGrow) {
