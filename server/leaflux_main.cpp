@@ -82,7 +82,7 @@ int RunSolve(const SolveCommand& command) {
 
 struct GenerateCommand {
     TreeParameters tree;
-    int rows = 1, columns = 1;
+    int rows = 1, columns = 1, trees = 0;
     double spacing = 6.0, rowSpacing = 0.0, rowAzimuth = 0.0, sunElevation = 50.0,
            sunAzimuth = 160.0;
     double sunPar = 400.0, sunNir = 350.0, skyPar = 100.0, skyNir = 60.0;
@@ -114,6 +114,7 @@ int RunGenerate(const GenerateCommand& command) {
     plantation.tree = command.tree;
     plantation.rows = command.rows;
     plantation.columns = command.columns;
+    plantation.trees = command.trees;
     plantation.columnSpacingM = command.spacing;
     plantation.rowSpacingM = command.rowSpacing > 0.0 ? command.rowSpacing : command.spacing;
     plantation.rowAzimuthDeg = command.rowAzimuth;
@@ -291,6 +292,10 @@ int main(int argc, char** argv) {
     generateApp->add_option("--rows", generate.rows, "Rows of trees")->check(CLI::Range(1, 1000));
     generateApp->add_option("--columns", generate.columns, "Trees per row")
         ->check(CLI::Range(1, 1000));
+    generateApp
+        ->add_option("--trees", generate.trees,
+                     "Only this many trees of the rows x columns grid, row by row (0: all)")
+        ->check(CLI::Range(0, 1'000'000));
     generateApp->add_option("--spacing", generate.spacing, "Distance between trees (m)")
         ->check(CLI::PositiveNumber);
     generateApp

@@ -258,8 +258,10 @@ void AddPlantation(Scene& scene, const PlantationParameters& parameters,
     NodeId next = 1;
     for (const Node& node : scene.nodes) next = std::max(next, node.id + 1);
     Random jitter(StreamSeed(parameters.tree.seed, 0xB0A7));
-    for (int r = 0; r < parameters.rows; ++r) {
-        for (int c = 0; c < parameters.columns; ++c) {
+    const int trees =
+        parameters.trees > 0 ? parameters.trees : parameters.rows * parameters.columns;
+    for (int r = 0, placed = 0; r < parameters.rows; ++r) {
+        for (int c = 0; c < parameters.columns && placed < trees; ++c, ++placed) {
             const double x = (c - 0.5 * (parameters.columns - 1)) * parameters.columnSpacingM +
                              parameters.jitterM * (2.0 * jitter.Uniform() - 1.0);
             const double y = (r - 0.5 * (parameters.rows - 1)) * parameters.rowSpacingM +

@@ -39,6 +39,7 @@ NodeId AddTree(Scene& scene, const TreeParameters& parameters, const glm::dvec3&
 struct PlantationParameters {
     TreeParameters tree;
     int rows = 1, columns = 1;
+    int trees = 0;  // only the first trees of the grid, row by row (0: every position)
     double rowSpacingM = 5.0, columnSpacingM = 5.0;
     double jitterM = 0.5;        // uniform random offset of each tree, in x and y
     double rowAzimuthDeg = 0.0;  // direction of the rows, from north clockwise

@@ -409,6 +409,30 @@ class HrcSolver {
         bool near = false;  // exact link: R's centre does not speak for all of R
     };
 
+    // Radiosity of patch s on one side, summed over bands (W/m²).
+    double SideRadiosity(std::uint32_t s, int side) const {
+        double total = 0.0;
+        for (int b = 0; b < bands_; ++b) total += radiosity_[s][side][b];
+        return total;
+    }
+    double BrighterSide(std::uint32_t s) const {
+        return std::max(SideRadiosity(s, kUpper), SideRadiosity(s, kLower));
+    }
+    // Whether node R reaches across the plane of patch S: then its centroid's side is not
+    // the side all of R sees (a wall beside a lamp, partly above it). A patch in S's plane
+    // sees nothing of S and is not across it.
+    static bool Across(const HrcNode& R, const HrcNode& S) {
+        if (!R.patch) return std::abs(glm::dot(S.normal, R.centroid - S.a)) < R.radius;
+        const double tolerance = 1e-9 * R.radius;
+        double below = 0.0, above = 0.0;
+        for (const glm::dvec3& p : {R.a, R.b, R.c}) {
+            const double height = glm::dot(S.normal, p - S.a);
+            below = std::min(below, height);
+            above = std::max(above, height);
+        }
+        return below < -tolerance && above > tolerance;
+    }
+
     Estimate EstimatePair(std::uint32_t r, std::uint32_t s) const {
         const HrcNode& R = hierarchy_[r];
         const HrcNode& S = hierarchy_[s];
@@ -428,8 +452,10 @@ class HrcSolver {
                 std::max(glm::dot(centre - R.centroid, centre - R.centroid), 1e-300);
             const double spread = std::min(R.spread * R.spread / (3.0 * square), 1.0);
             e.geometric = SphericalTriangleSolidAngle(ra, rb, rc) / kPi * (1.0 + spread);
-            double radiosity = 0.0;
-            for (int b = 0; b < bands_; ++b) radiosity += radiosity_[s][e.senderSide][b];
+            // A receiver across S's plane takes light from both its sides: the error
+            // is judged by the brighter one.
+            const double radiosity =
+                Across(R, S) ? BrighterSide(s) : SideRadiosity(s, e.senderSide);
             // One direction stands for the whole patch and R for all its points.
             e.geometricError =
                 std::min(1.0, std::pow((R.radius + S.radius) / std::max(d, 1e-300), 2.0));
@@ -470,12 +496,13 @@ class HrcSolver {
         e.form = PointToTriangle(x, R.normal, S.a, S.b, S.c);
         e.senderSide = glm::dot(S.normal, x - (S.a + S.b + S.c) / 3.0) >= 0.0 ? kUpper : kLower;
         e.toSender = glm::normalize((S.a + S.b + S.c) / 3.0 - x);
-        double radiosity = 0.0;
-        for (int b = 0; b < bands_; ++b) radiosity += radiosity_[s][e.senderSide][b];
         const double d = std::max(glm::length(S.centroid - R.centroid), 1e-300);
         // The form factor at R's centroid speaks for all of R only when R is small against
-        // the distance; otherwise parts of R may see S fully (F up to 1 on each side).
-        e.near = R.radius > 0.5 * d;
+        // the distance, and lies on one side of S's plane; otherwise parts of R may see S
+        // fully (F up to 1 on each side), and from S's other side.
+        const bool across = Across(R, S);
+        e.near = R.radius > 0.5 * d || across;
+        const double radiosity = across ? BrighterSide(s) : SideRadiosity(s, e.senderSide);
         e.power = radiosity * (e.near ? 1.0 : e.form.upper + e.form.lower) * R.areaM2;
         e.geometricError = std::pow(R.radius / d, 2.0);
         return e;
