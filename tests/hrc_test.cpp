@@ -89,6 +89,51 @@ TEST(HrcStem, AStripIsLitOnBothSidesAndATubeOnlyOutside) {
     EXPECT_NEAR(t.light[0][0].irradianceLowerWm2, 1000 * std::cos(glm::radians(30.0)), 1e-6);
 }
 
+// A lamp bar (15 cm × 5.12 m, its two triangles slivers) facing down 2.4 m up, beside a
+// black wall 0.78 m away that rises above it: the power onto the wall against the
+// double integral of L cos θ_s cos θ_r / r² (midpoint rule, ≈ 0.02 % here). A wall patch
+// across the lamp's plane sees its emitting side from its lower part only; judged by its
+// centre alone it was taken as unlit, and the wall got 12 % too little.
+TEST(HrcLamp, LightsAWallThatRisesAboveIt) {
+    Scene scene = OneBandScene({{"black", Opaque(0.0)}});
+    const double halfWidth = 0.075, halfLength = 2.56, height = 2.4, wallX = 0.855;
+    scene.sources.emitters.push_back(
+        {"lamp",
+         Quad({-halfWidth, -halfLength, height}, {-halfWidth, halfLength, height},
+              {halfWidth, halfLength, height}, {halfWidth, -halfLength, height}),  // facing down
+         {1000.0},
+         ""});
+    scene.environment.push_back(
+        {"wall", Quad({wallX, -3, 0}, {wallX, -3, 3}, {wallX, 3, 3}, {wallX, 3, 0}), "black"});
+    scene.Validate();
+    double expectedW = 0.0;
+    const int lampX = 4, lampY = 200, wallY = 120, wallZ = 60;
+    const double lampCell = (2 * halfWidth / lampX) * (2 * halfLength / lampY);
+    const double wallCell = (6.0 / wallY) * (3.0 / wallZ);
+    for (int i = 0; i < wallY; ++i) {
+        for (int j = 0; j < wallZ; ++j) {
+            const glm::dvec3 p(wallX, -3.0 + 6.0 * (i + 0.5) / wallY, 3.0 * (j + 0.5) / wallZ);
+            if (p.z >= height) continue;  // above the lamp: its back only
+            for (int k = 0; k < lampX; ++k) {
+                for (int l = 0; l < lampY; ++l) {
+                    const glm::dvec3 q(-halfWidth + 2 * halfWidth * (k + 0.5) / lampX,
+                                       -halfLength + 2 * halfLength * (l + 0.5) / lampY, height);
+                    const glm::dvec3 d = q - p;
+                    const double r2 = glm::dot(d, d);
+                    expectedW += 1000.0 / kPi * (d.z * -d.x) / (r2 * r2) * lampCell * wallCell;
+                }
+            }
+        }
+    }
+    SolverSettings settings;
+    settings.kind = SolverKind::kHrc;
+    settings.hrc.epsilon = 1e-6;
+    settings.hrc.directOnly = true;
+    const PreparedScene prepared(scene);
+    const Solution s = Solve(prepared, settings);
+    EXPECT_NEAR(s.light[0][0].irradianceUpperWm2 * 18.0, expectedW, 0.01 * expectedW);
+}
+
 struct ViewFactorCase {
     const char* name;
     std::shared_ptr<const Mesh> emitter, receiver;
