@@ -60,6 +60,13 @@ def replace_section(text, name, body):
     return pattern.sub(lambda _: f"{begin}\n{body.strip()}\n{end}", text)
 
 
+def update_readme(name, body):
+    """Rewrites one section; the README is read just before, so edits made meanwhile stay."""
+    path = os.path.join(ROOT, "README.md")
+    text = replace_section(open(path).read(), name, body)
+    open(path, "w").write(text)
+
+
 def number(value, digits=3):
     v = float(value)
     if v == 0:
@@ -145,20 +152,16 @@ def main():
     args = parser.parse_args()
     build, out = os.path.abspath(args.build), os.path.abspath(args.out)
     os.makedirs(REPORT, exist_ok=True)
-    readme_path = os.path.join(ROOT, "README.md")
-    readme = open(readme_path).read()
     parts = args.only.split(",")
     if "error" in parts:
         os.makedirs(os.path.join(out, "error"), exist_ok=True)
         for name in args.scenes.split(","):
-            readme = replace_section(readme, f"error-{name}",
-                                     error_section(build, os.path.join(out, "error"), name))
-            open(readme_path, "w").write(readme)  # what is measured is kept, even if a later run fails
+            # Each table is written as soon as it is measured.
+            update_readme(f"error-{name}", error_section(build, os.path.join(out, "error"), name))
     if "scaling" in parts:
-        readme = replace_section(readme, "scaling", scaling_section(build, os.path.join(out, "scaling")))
+        update_readme("scaling", scaling_section(build, os.path.join(out, "scaling")))
     if "growth" in parts:
-        readme = replace_section(readme, "growth", growth_section(args.demo))
-    open(readme_path, "w").write(readme)
+        update_readme("growth", growth_section(args.demo))
     print(f"README.md sections {args.only} rewritten; files in {REPORT}")
 
 

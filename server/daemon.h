@@ -7,6 +7,7 @@
 #pragma once
 
 #include <atomic>
+#include <optional>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -27,7 +28,8 @@ class Session {
 
     // Applies a cycle's delta and suns to a copy of the scene, validates it whole, solves
     // it for what the cycle's outputs ask, and only then keeps it. Throws InputError
-    // (naming the field or node) and leaves the session as it was otherwise.
+    // (naming the field or node) and leaves the session as it was otherwise. A cycle that
+    // changes nothing and asks what the last one asked gets the last one's light again.
     v1::CycleResult Run(const v1::Cycle& cycle);
 
     // What Status reports; readable while the session solves.
@@ -44,6 +46,10 @@ class Session {
     Scene scene_;
     MeshLibrary meshes_;
     SolverSettings settings_;
+    // The last cycle's result and the outputs it answered (serialised), for a cycle that
+    // changes nothing: the solvers are deterministic, so it would get the same light.
+    std::string lastOutputs_;
+    std::optional<v1::CycleResult> last_;
     std::atomic<std::int64_t> cycles_{0};
     std::atomic<int> nodes_{0}, organs_{0};
 };

@@ -584,6 +584,51 @@ TEST_F(DaemonOnLoopback, SessionsSolveInParallelAndADepartedClientDisturbsNoOne)
 }
 
 // A cycle that asks for one band gets that band alone, solved for it alone.
+// A cycle that changes nothing and asks what the last one asked gets the last one's light
+// again, without solving; other outputs, a delta or new suns are solved.
+TEST(DaemonCycles, AnUnchangedCycleGetsTheLastLightWithoutSolving) {
+    Daemon daemon;
+    const std::string session = daemon.Handle(OpenRequest()).opened().session();
+    const v1::Reply first = daemon.Handle(CycleRequest(session, 1));
+    ASSERT_TRUE(first.has_cycle()) << first.DebugString();
+    EXPECT_FALSE(first.cycle().statistics().reused());
+
+    const v1::Reply again = daemon.Handle(CycleRequest(session, 2));
+    ASSERT_TRUE(again.has_cycle()) << again.DebugString();
+    EXPECT_TRUE(again.cycle().statistics().reused());
+    EXPECT_EQ(again.cycle().number(), 2);
+    EXPECT_EQ(again.cycle().statistics().wall_seconds(), 0.0);
+    v1::CycleResult expected = first.cycle();
+    expected.set_number(2);
+    *expected.mutable_statistics() = again.cycle().statistics();
+    EXPECT_EQ(again.cycle().SerializeAsString(), expected.SerializeAsString());
+
+    v1::Request leavesOnly = CycleRequest(session, 3);
+    leavesOnly.mutable_cycle()->mutable_outputs()->set_structures(false);
+    const v1::Reply third = daemon.Handle(leavesOnly);
+    EXPECT_FALSE(third.cycle().statistics().reused());
+    EXPECT_EQ(third.cycle().structures_size(), 0);
+
+    v1::Request lower = CycleRequest(session, 4);
+    lower.mutable_cycle()->mutable_outputs()->set_structures(false);
+    v1::Sun* sun = lower.mutable_cycle()->add_suns();
+    sun->mutable_direction()->set_z(1.0);
+    (*sun->mutable_normal_irradiance())["PAR"] = 500.0;
+    const v1::Reply fourth = daemon.Handle(lower);
+    EXPECT_FALSE(fourth.cycle().statistics().reused());
+    EXPECT_NEAR(fourth.cycle().organs(0).bands(0).irradiance_upper_wm2(), 500.0, 1e-9);
+
+    v1::Request grow = CycleRequest(session, 5);
+    grow.mutable_cycle()->mutable_outputs()->set_structures(false);
+    *grow.mutable_cycle()->mutable_delta()->add_added() = Leaf(3, 1, 0.02, 0.9);
+    const v1::Reply fifth = daemon.Handle(grow);
+    EXPECT_FALSE(fifth.cycle().statistics().reused());
+    EXPECT_EQ(fifth.cycle().organs_size(), 2);
+    v1::Request status;
+    status.mutable_status()->set_session(session);
+    EXPECT_EQ(daemon.Handle(status).status().sessions(0).cycles(), 5);
+}
+
 TEST(DaemonBands, OnlyTheRequestedBandsAreSolvedAndSent) {
     v1::Request open = OpenRequest();
     v1::Scene* scene = open.mutable_open_session()->mutable_scene();
