@@ -74,22 +74,23 @@ def number(value, digits=3):
     return f"{v:,.0f}" if abs(v) >= 100 else f"{v:.{digits}g}"
 
 
-def error_section(build, out, name):
-    """Runs `leaflux bench error` on one scene; returns its README table."""
+def error_section(build, out, name, run=True):
+    """Runs `leaflux bench error` on one scene (unless not `run`: its CSV is there); returns
+    its README table."""
     leaflux = os.path.join(build, "server", "leaflux")
     make, description, options = SCENES[name]
-    if make is None:
+    if run:
         scene = os.path.join(HERE, "scenes", f"{name}.scene.txtpb")
-    else:
-        scene = os.path.join(out, f"{name}.scene.txtpb")
-        subprocess.run([leaflux, "generate", *make, "--out", scene], check=True, capture_output=True)
-    subprocess.run([leaflux, "bench", "error", "--scene", scene, "--name", name, "--out", out,
-                    "--cache", os.path.join(out, "cache"), *options], check=True)
-    for ext in ("csv", "png"):
-        shutil.copy(os.path.join(out, f"{name}.{ext}"), os.path.join(REPORT, f"error_{name}.{ext}"))
+        if make is not None:
+            scene = os.path.join(out, f"{name}.scene.txtpb")
+            subprocess.run([leaflux, "generate", *make, "--out", scene], check=True, capture_output=True)
+        subprocess.run([leaflux, "bench", "error", "--scene", scene, "--name", name, "--out", out,
+                        "--cache", os.path.join(out, "cache"), *options], check=True)
+        for ext in ("csv", "png"):
+            shutil.copy(os.path.join(out, f"{name}.{ext}"), os.path.join(REPORT, f"error_{name}.{ext}"))
     rows = list(csv.DictReader(open(os.path.join(out, f"{name}.csv"))))
     per = " / ".join(dict.fromkeys(r["band"] for r in rows))
-    table = [f"**{name}** — {description}; {rows[0]['leaves']} leaves. "
+    table = [f"**{name}** — {description}; {int(rows[0]['leaves']):,} leaves. "
              f"![{name}](examples/report/error_{name}.png)", "",
              f"| solver | setting | wall s | cpu s | peak MiB | L2 % of max, {per} | mean rel. %, {per} | "
              f"p95 rel. %, {per} | balance %, {per} |", "|---|---|---|---|---|---|---|---|---|"]
@@ -97,11 +98,12 @@ def error_section(build, out, name):
         by_band = [r for r in rows if (r["solver"], r["setting"]) == key]
         first = by_band[0]
         joined = lambda column: " / ".join(number(r[column]) for r in by_band)
-        l2 = joined("l2_pct_of_max") if not key[1].startswith("reference") else \
-            "floor " + joined("reference_floor_pct")
+        if key[1].startswith("reference"):  # its own error is its standard error
+            errors = f"floor {joined('reference_floor_pct')} | – | –"
+        else:
+            errors = f"{joined('l2_pct_of_max')} | {joined('mean_rel_pct')} | {joined('p95_rel_pct')}"
         table.append(f"| {key[0]} | {key[1]} | {number(first['wall_s'])} | {number(first['cpu_s'])} | "
-                     f"{number(first['peak_mib'])} | {l2} | {joined('mean_rel_pct')} | "
-                     f"{joined('p95_rel_pct')} | {joined('balance_residual_pct')} |")
+                     f"{number(first['peak_mib'])} | {errors} | {joined('balance_residual_pct')} |")
     return "\n".join(table)
 
 
@@ -149,6 +151,8 @@ def main():
     parser.add_argument("--only", default="error,scaling,growth")
     parser.add_argument("--scenes", default=",".join(SCENES))
     parser.add_argument("--demo", default=os.path.join(ROOT, "out", "demo"))
+    parser.add_argument("--tables-only", action="store_true",
+                        help="rewrite the error tables from the CSVs in OUT_DIR, run nothing")
     args = parser.parse_args()
     build, out = os.path.abspath(args.build), os.path.abspath(args.out)
     os.makedirs(REPORT, exist_ok=True)
@@ -157,7 +161,8 @@ def main():
         os.makedirs(os.path.join(out, "error"), exist_ok=True)
         for name in args.scenes.split(","):
             # Each table is written as soon as it is measured.
-            update_readme(f"error-{name}", error_section(build, os.path.join(out, "error"), name))
+            update_readme(f"error-{name}",
+                          error_section(build, os.path.join(out, "error"), name, not args.tables_only))
     if "scaling" in parts:
         update_readme("scaling", scaling_section(build, os.path.join(out, "scaling")))
     if "growth" in parts:

@@ -407,16 +407,22 @@ class HrcSolver {
         int senderSide = kUpper;
         glm::dvec3 toSender{0, 0, 1};
         bool near = false;  // exact link: R's centre does not speak for all of R
+        // Exact link: W that parts of R across S's plane take from S's other side, which
+        // the link (one side, the centre's) gets wrong.
+        double sideError = 0.0;
     };
+
+    // The error a link would carry with visibility v (W).
+    double Error(const Estimate& e, double v) const {
+        return e.power * (e.geometricError + VisibilitySpread(v, options_.visibilityRays)) +
+               e.sideError;
+    }
 
     // Radiosity of patch s on one side, summed over bands (W/m²).
     double SideRadiosity(std::uint32_t s, int side) const {
         double total = 0.0;
         for (int b = 0; b < bands_; ++b) total += radiosity_[s][side][b];
         return total;
-    }
-    double BrighterSide(std::uint32_t s) const {
-        return std::max(SideRadiosity(s, kUpper), SideRadiosity(s, kLower));
     }
     // Whether node R reaches across the plane of patch S: then its centroid's side is not
     // the side all of R sees (a wall beside a lamp, partly above it). A patch in S's plane
@@ -452,10 +458,7 @@ class HrcSolver {
                 std::max(glm::dot(centre - R.centroid, centre - R.centroid), 1e-300);
             const double spread = std::min(R.spread * R.spread / (3.0 * square), 1.0);
             e.geometric = SphericalTriangleSolidAngle(ra, rb, rc) / kPi * (1.0 + spread);
-            // A receiver across S's plane takes light from both its sides: the error
-            // is judged by the brighter one.
-            const double radiosity =
-                Across(R, S) ? BrighterSide(s) : SideRadiosity(s, e.senderSide);
+            const double radiosity = SideRadiosity(s, e.senderSide);
             // One direction stands for the whole patch and R for all its points.
             e.geometricError =
                 std::min(1.0, std::pow((R.radius + S.radius) / std::max(d, 1e-300), 2.0));
@@ -498,12 +501,22 @@ class HrcSolver {
         e.toSender = glm::normalize((S.a + S.b + S.c) / 3.0 - x);
         const double d = std::max(glm::length(S.centroid - R.centroid), 1e-300);
         // The form factor at R's centroid speaks for all of R only when R is small against
-        // the distance, and lies on one side of S's plane; otherwise parts of R may see S
-        // fully (F up to 1 on each side), and from S's other side.
-        const bool across = Across(R, S);
-        e.near = R.radius > 0.5 * d || across;
-        const double radiosity = across ? BrighterSide(s) : SideRadiosity(s, e.senderSide);
+        // the distance; otherwise parts of R may see S fully (F up to 1 on each side).
+        e.near = R.radius > 0.5 * d;
+        const double radiosity = SideRadiosity(s, e.senderSide);
         e.power = radiosity * (e.near ? 1.0 : e.form.upper + e.form.lower) * R.areaM2;
+        if (Across(R, S)) {
+            // Part of R lies across S's plane and sees S's other side: judged at R's corners
+            // (drawn in a little) — a wall beside a lamp, rising above it, is lit below the
+            // lamp's plane even where its centre is not.
+            for (const glm::dvec3& corner : {R.a, R.b, R.c}) {
+                const glm::dvec3 p = corner + 1e-3 * (x - corner);
+                const SidedFormFactor f = PointToTriangle(p, R.normal, S.a, S.b, S.c);
+                const int side = glm::dot(S.normal, p - S.a) >= 0.0 ? kUpper : kLower;
+                e.sideError = std::max(e.sideError, std::abs(SideRadiosity(s, side) - radiosity) *
+                                                        (f.upper + f.lower) * R.areaM2);
+            }
+        }
         e.geometricError = std::pow(R.radius / d, 2.0);
         return e;
     }
@@ -517,11 +530,9 @@ class HrcSolver {
         if (exact && !e.near && e.form.upper + e.form.lower <= 0.0) return;
         // Geometry alone may call for a split: then no visibility rays are spent on it.
         const double threshold = options_.epsilon * totalPower_;
-        if (e.power * e.geometricError > threshold && Split(r, s)) return;
+        if (e.power * e.geometricError + e.sideError > threshold && Split(r, s)) return;
         const double v = Visibility(r, s);
-        const double error =
-            e.power * (e.geometricError + VisibilitySpread(v, options_.visibilityRays));
-        if (error > threshold && Split(r, s)) return;
+        if (Error(e, v) > threshold && Split(r, s)) return;
         if (v <= 0.0 || (exact && e.form.upper + e.form.lower <= 0.0)) return;
         NodeLink link;
         link.sender = s;
@@ -556,10 +567,7 @@ class HrcSolver {
             for (const NodeLink& link : links_[r]) {
                 const Estimate e =
                     link.exact ? EstimateExact(r, link.sender) : EstimatePair(r, link.sender);
-                const double error =
-                    e.power *
-                    (e.geometricError + VisibilitySpread(link.visibility, options_.visibilityRays));
-                (error > threshold ? refine : kept).push_back(link);
+                (Error(e, link.visibility) > threshold ? refine : kept).push_back(link);
             }
             if (refine.empty()) continue;
             links_[r] = std::move(kept);
