@@ -6,6 +6,7 @@
 
 #include "solver/check.h"
 #include "solver/error.h"
+#include "solver/geometry.h"
 #include "solver/sampling.h"
 
 namespace leaflux {
@@ -287,16 +288,25 @@ void AddGreenhouse(Scene& scene, const GreenhouseParameters& p) {
         throw InputError(ErrorCode::kInvalidArgument, "greenhouse.lamp_exitance",
                          "needs one exitance per band");
     }
-    AddPlantation(scene, p.plantation, p.floorOptics);
-    const PlantationFrame frame(p.plantation);
-    const glm::dvec3 corners[4] = {{-1, -1, 0}, {-1, 1, 0}, {1, 1, 0}, {1, -1, 0}};
-    const glm::dvec3 up(0, 0, p.wallHeightM);
+    AddPlantation(scene, p.plantation, "");
+    // The house stands 20 cm clear of the plants, whatever their crowns: a leaf through a
+    // wall would be lit by the lamps of a room it is not in.
+    const FlatScene plants = Flatten(scene);
+    const glm::dvec3 low = plants.origin + plants.boundsMin - glm::dvec3(0.2, 0.2, 0.0);
+    const glm::dvec3 high = plants.origin + plants.boundsMax + glm::dvec3(0.2, 0.2, 0.0);
+    const glm::dvec3 corners[4] = {
+        {low.x, low.y, 0}, {high.x, low.y, 0}, {high.x, high.y, 0}, {low.x, high.y, 0}};
+    scene.environment.push_back(
+        {"floor", QuadFacing(corners[0], corners[1], corners[2], corners[3], {0, 0, 1}),
+         p.floorOptics});
+    const glm::dvec3 up(0, 0, p.wallHeightM), middle = 0.5 * (low + high);
     for (int w = 0; w < 4; ++w) {
-        const glm::dvec3 a = frame.At(corners[w]), b = frame.At(corners[(w + 1) % 4]);
-        scene.environment.push_back({"wall" + std::to_string(w),
-                                     QuadFacing(a, a + up, b + up, b, -(a + b)),  // inwards
-                                     p.wallOptics});
+        const glm::dvec3 a = corners[w], b = corners[(w + 1) % 4];
+        const glm::dvec3 inwards = glm::dvec3(middle.x, middle.y, 0) - 0.5 * (a + b);
+        scene.environment.push_back(
+            {"wall" + std::to_string(w), QuadFacing(a, a + up, b + up, b, inwards), p.wallOptics});
     }
+    const PlantationFrame frame(p.plantation);
     // Rows run along `along`, at the plantation's row positions across.
     const PlantationParameters& plantation = p.plantation;
     const double halfLength = 0.4 * plantation.columns * plantation.columnSpacingM;

@@ -52,10 +52,10 @@ void AddPlantation(Scene& scene, const PlantationParameters& parameters,
                    const std::string& groundOptics);
 
 // A greenhouse compartment at night: a plantation of small plants on a floor (optics
-// `floorOptics`), four walls (`wallOptics`, upper sides facing in) of the floor's extent
-// and `wallHeightM` high, no roof (a glass roof lets scattered light out), and above each
-// row a bar of lamps facing down: 80 % of the row's length, `lampWidthM` wide, at
-// `lampHeightM`, emitting `lampExitanceWm2` per band (black: they absorb what they get).
+// `floorOptics`) 20 cm wider than the plants on every side, four walls round it
+// (`wallOptics`, upper sides facing in) `wallHeightM` high, no roof (a glass roof lets scattered
+// light out), and above each row a bar of lamps facing down: 80 % of the row's length, `lampWidthM`
+// wide, at `lampHeightM`, emitting `lampExitanceWm2` per band (black: they absorb what they get).
 struct GreenhouseParameters {
     PlantationParameters plantation;
     double wallHeightM = 3.0;
