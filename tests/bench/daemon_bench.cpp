@@ -1,5 +1,6 @@
 // leafluxd over loopback TCP: the protocol's own cost (Status round trips, a cycle with an
-// empty delta on a one-leaf scene) and the latency of cycles of a plant growing to 1,000
+// empty delta, answered with the last cycle's light, or solved again when it asks other
+// outputs) and the latency of cycles of a plant growing to 1,000
 // and 10,000 leaves (HRC, ε = 1e-4), one tenth of the plant added per cycle.
 // Run: build/release/tests/leaflux_bench_daemon [out.csv]
 #include <chrono>
@@ -114,14 +115,21 @@ int main(int argc, char** argv) {
             rows.push_back({"growing_tree", leaves, c, reply.cycle().organs_size(),
                             1e3 * Seconds(start), 1e3 * reply.cycle().statistics().wall_seconds()});
         }
-        // The same plant again with nothing changed: the protocol and the solve alone.
-        v1::Request same;
-        same.mutable_cycle()->set_session(session);
-        same.mutable_cycle()->set_number(kCycles + 1);
-        const auto start = Clock::now();
-        const v1::Reply reply = daemon.Call(same);
-        rows.push_back({"empty_delta", leaves, kCycles + 1, 0, 1e3 * Seconds(start),
-                        1e3 * reply.cycle().statistics().wall_seconds()});
+        // The same plant again with nothing changed. Asking what the last cycle asked, its
+        // light comes back unsolved: the protocol alone (and the organs' results). Asking
+        // other outputs (none), it is solved again: validation, flattening, ray engine
+        // and solve, without growth.
+        for (const bool sameOutputs : {true, false}) {
+            v1::Request same;
+            same.mutable_cycle()->set_session(session);
+            same.mutable_cycle()->set_number(kCycles + (sameOutputs ? 1 : 2));
+            same.mutable_cycle()->mutable_outputs()->set_leaves(sameOutputs);
+            const auto start = Clock::now();
+            const v1::Reply reply = daemon.Call(same);
+            rows.push_back({sameOutputs ? "empty_delta" : "empty_resolve", leaves,
+                            kCycles + (sameOutputs ? 1 : 2), reply.cycle().organs_size(),
+                            1e3 * Seconds(start), 1e3 * reply.cycle().statistics().wall_seconds()});
+        }
     }
     const char* path = argc > 1 ? argv[1] : "daemon_bench.csv";
     std::ofstream csv(path);
