@@ -7,12 +7,12 @@
 #pragma once
 
 #include <atomic>
-#include <optional>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 
 #include "leaflux.pb.h"
