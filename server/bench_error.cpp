@@ -175,14 +175,14 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
     if (options.directOnly) {
         // Deterministic direct light, as fine as the finest HRC run: what ignoring
         // scattering costs in accuracy, and what it saves in time.
-        Run run{"direct", "hrc", base};
+        Run run{"direct", "", base};
         run.settings.kind = SolverKind::kHrc;
         run.settings.hrc.directOnly = true;
         if (!options.hrcEpsilons.empty()) {
             run.settings.hrc.epsilon =
                 *std::min_element(options.hrcEpsilons.begin(), options.hrcEpsilons.end());
-            run.setting = "epsilon=" + Number(run.settings.hrc.epsilon);
         }
+        run.setting = "epsilon=" + Number(run.settings.hrc.epsilon);
         runs.push_back(run);
     }
     return runs;
