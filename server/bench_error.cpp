@@ -159,7 +159,17 @@ struct Run {
 std::vector<Run> Runs(const ErrorBenchOptions& options) {
     std::vector<Run> runs;
     SolverSettings base;
+    base.hrc = options.hrc;
     base.monteCarlo.threads = base.hrc.threads = options.threads;
+    // HRC settings other than the defaults are named with each run's ε.
+    const HrcOptions defaults;
+    std::string hrcSetting;
+    if (options.hrc.maxSubdivision != defaults.maxSubdivision)
+        hrcSetting += " subdivision=" + std::to_string(options.hrc.maxSubdivision);
+    if (options.hrc.visibilityRays != defaults.visibilityRays)
+        hrcSetting += " rays=" + std::to_string(options.hrc.visibilityRays);
+    if (options.hrc.directionLevel != defaults.directionLevel)
+        hrcSetting += " directions=" + std::to_string(options.hrc.directionLevel);
     for (int samples : options.monteCarloSamples) {
         Run run{"mc", "samples=" + std::to_string(samples), base};
         run.settings.kind = SolverKind::kMonteCarlo;
@@ -167,7 +177,7 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
         runs.push_back(run);
     }
     for (double epsilon : options.hrcEpsilons) {
-        Run run{"hrc", "epsilon=" + Number(epsilon), base};
+        Run run{"hrc", "epsilon=" + Number(epsilon) + hrcSetting, base};
         run.settings.kind = SolverKind::kHrc;
         run.settings.hrc.epsilon = epsilon;
         runs.push_back(run);
@@ -182,7 +192,7 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
             run.settings.hrc.epsilon =
                 *std::min_element(options.hrcEpsilons.begin(), options.hrcEpsilons.end());
         }
-        run.setting = "epsilon=" + Number(run.settings.hrc.epsilon);
+        run.setting = "epsilon=" + Number(run.settings.hrc.epsilon) + hrcSetting;
         runs.push_back(run);
     }
     return runs;

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "solver/radiosity/hrc.h"
+
 namespace leaflux {
 
 struct ErrorBenchOptions {
@@ -22,6 +24,7 @@ struct ErrorBenchOptions {
     std::uint64_t referenceSeed = 99;
     std::vector<int> monteCarloSamples{64, 256, 1024};
     std::vector<double> hrcEpsilons{1e-3, 1e-4, 1e-5};
+    HrcOptions hrc;          // the HRC runs' other settings (subdivision, rays, directions)
     bool directOnly = true;  // also direct light only (HRC, the finest ε)
     int threads = 0;
 };

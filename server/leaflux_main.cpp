@@ -407,6 +407,18 @@ int main(int argc, char** argv) {
     errorApp->add_option("--hrc-epsilon", errorBench.hrcEpsilons, "HRC runs: ε of each")
         ->delimiter(',')
         ->check(CLI::Range(1e-9, 1.0));
+    errorApp
+        ->add_option("--hrc-subdivision", errorBench.hrc.maxSubdivision,
+                     "HRC runs: times a triangle may be split in four")
+        ->check(CLI::Range(0, 8));
+    errorApp
+        ->add_option("--hrc-visibility-rays", errorBench.hrc.visibilityRays,
+                     "HRC runs: rays estimating each link's visibility")
+        ->check(CLI::Range(1, 1024));
+    errorApp
+        ->add_option("--hrc-direction-level", errorBench.hrc.directionLevel,
+                     "HRC runs: direction set of cluster light, 0..4")
+        ->check(CLI::Range(0, 4));
     errorApp->add_flag("!--no-direct", errorBench.directOnly,
                        "No direct-light-only run (HRC at the finest ε)");
     bool noMonteCarlo = false, noHrc = false;

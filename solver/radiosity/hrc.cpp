@@ -103,6 +103,25 @@ struct SourceLink {
     double visibility;
 };
 
+// Refinement (HrcSolver::Refine): a task, and the verdict on it.
+struct Task {
+    enum Kind : std::uint8_t {
+        kSource,  // light of directional source s on node r
+        kPair,    // light of node s on node r
+        kSplit,   // the pair (r, s) must be split (its link failed Rerefine)
+        kSelf,    // the exchanges inside cluster r
+    };
+    Kind kind;
+    std::uint32_t r, s;
+};
+
+struct Verdict {
+    enum Kind : std::uint8_t { kNone, kLink, kSplitReceiver, kSplitSender };
+    Kind kind = kNone;
+    NodeLink link;  // kLink of a pair; a source's visibility is link.visibility
+    std::int64_t rays = 0;
+};
+
 // How uncertain a visibility estimated from n rays is, as 2√(v(1−v)) with v taken by
 // Laplace's rule, (visible + 1) / (n + 2): never zero, since eight rays that all pass do
 // not prove that nothing is in the way.
@@ -264,8 +283,12 @@ class HrcSolver {
     }
 
     // The unoccluded fraction of the light from s that r's points take, from stratified
-    // rays between points of r and s, weighted as push-down hands the light to patches.
-    double Visibility(std::uint32_t r, std::uint32_t s) {
+    // rays between points x of r and y of s, each weighted by what it carries, the form
+    // factor's kernel |cos θx| |cos θy| / |x − y|² (the receiving cosine as push-down hands
+    // the light to patches). Unweighted, far pairs count as much as near ones and are more
+    // often blocked: the 500-leaf canopy at ρ = τ = 0.45 lost 2.3 % of its NIR that way.
+    // Counts the rays it traces in `rays`.
+    double Visibility(std::uint32_t r, std::uint32_t s, std::int64_t& rays) const {
         Random random(StreamSeed(0x5EED, r, s));
         const int count = options_.visibilityRays;
         double visible = 0.0, total = 0.0;
@@ -276,9 +299,10 @@ class HrcSolver {
             const glm::dvec3 d = q.position - p.position;
             const double distance = glm::length(d);
             if (distance <= 0.0) continue;
-            const double weight = ReceivingWeight(p.triangle, p.normal, d / distance);
+            const double weight = ReceivingWeight(p.triangle, p.normal, d / distance) *
+                                  std::abs(glm::dot(q.normal, d)) / std::pow(distance, 3.0);
             if (weight <= 0.0) continue;
-            ++rayCount_;
+            ++rays;
             total += weight;
             if (!rays_.Occluded({p.position, p.triangle}, d / distance, distance * (1.0 - 1e-4)))
                 visible += weight;
@@ -288,7 +312,7 @@ class HrcSolver {
 
     // The lit fraction of the node's area as seen from the source: sample points weighted
     // by |n · ω|, the weight with which push-down hands the source's light to each patch.
-    double SourceVisibility(std::uint32_t r, std::uint32_t source) {
+    double SourceVisibility(std::uint32_t r, std::uint32_t source, std::int64_t& rays) const {
         const glm::dvec3& toward = sources_[source].toward;
         Random random(StreamSeed(0x50C, r, source));
         const int count = options_.visibilityRays;
@@ -298,23 +322,32 @@ class HrcSolver {
                 hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
             const double weight = ReceivingWeight(p.triangle, p.normal, toward);
             if (weight <= 0.0) continue;
-            ++rayCount_;
+            ++rays;
             total += weight;
             if (!rays_.Occluded({p.position, p.triangle}, toward)) visible += weight;
         }
         return total > 0.0 ? visible / total : 0.0;
     }
 
-    // Whether node n can be split, subdividing a patch if it must.
-    bool Splittable(std::uint32_t n) {
-        HrcNode& node = hierarchy_[n];
-        if (!node.patch) return true;
-        if (!node.children.empty()) return true;
+    // Whether node n can be split: a cluster always, a patch already split or not yet at
+    // the deepest level and not too small.
+    bool CanSplit(std::uint32_t n) const {
+        const HrcNode& node = hierarchy_[n];
+        if (!node.patch || !node.children.empty()) return true;
         const int deepest = options_.maxSubdivision;
-        if (node.depth >= deepest) return false;
-        const double minArea =
-            flat_.triangles[node.triangle].areaM2 / std::pow(4.0, deepest) * 0.999;
-        if (!hierarchy_.Subdivide(n, minArea)) return false;
+        return node.depth < deepest && node.areaM2 / 4.0 >= MinArea(node);
+    }
+
+    double MinArea(const HrcNode& patch) const {
+        return flat_.triangles[patch.triangle].areaM2 / std::pow(4.0, options_.maxSubdivision) *
+               0.999;
+    }
+
+    // Splits node n, subdividing a patch if it must (CanSplit(n) holds).
+    void SplitNode(std::uint32_t n) {
+        HrcNode& node = hierarchy_[n];
+        if (!node.patch || !node.children.empty()) return;
+        LEAFLUX_CHECK(hierarchy_.Subdivide(n, MinArea(node)));
         Grow();
         for (std::uint32_t child : hierarchy_[n].children) {
             radiosity_[child] = radiosity_[n];
@@ -324,7 +357,6 @@ class HrcSolver {
             direct_.resize(hierarchy_.Size(), Sided{});
             for (std::uint32_t child : hierarchy_[n].children) direct_[child] = direct_[n];
         }
-        return true;
     }
 
     void Grow() {
@@ -336,57 +368,106 @@ class HrcSolver {
 
     // ---- Refinement ---------------------------------------------------------------------
 
-    void RefineSource(std::uint32_t r, std::uint32_t s) {
+    // Refinement is a stack of tasks worked through in chunks: the verdict on each task of
+    // a chunk (estimates, form factors, visibility rays) is found in parallel from a
+    // hierarchy that does not change meanwhile, then the verdicts are carried out in order
+    // — links stored, nodes split and their parts pushed as new tasks. The same tasks give
+    // the same links whatever the number of threads.
+    void Refine(std::vector<Task> stack) {
+        constexpr std::size_t kChunk = 4096;
+        std::vector<Task> chunk;
+        std::vector<Verdict> verdicts;
+        while (!stack.empty()) {
+            const std::size_t take = std::min(kChunk, stack.size());
+            chunk.assign(stack.end() - take, stack.end());
+            stack.resize(stack.size() - take);
+            verdicts.assign(take, Verdict{});
+            tbb::parallel_for(std::size_t{0}, take,
+                              [&](std::size_t i) { verdicts[i] = Judge(chunk[i]); });
+            // Carried out in reverse so that the first task's parts are on top of the stack.
+            for (std::size_t i = take; i-- > 0;) Carry(chunk[i], verdicts[i], stack);
+        }
+    }
+
+    Verdict Judge(const Task& task) const {
+        switch (task.kind) {
+            case Task::kSource:
+                return JudgeSource(task.r, task.s);
+            case Task::kPair:
+                return JudgePair(task.r, task.s);
+            case Task::kSplit:
+                return {SplitChoice(task.r, task.s), {}, 0};
+            case Task::kSelf:
+                return {};
+        }
+        return {};
+    }
+
+    void Carry(const Task& task, const Verdict& verdict, std::vector<Task>& stack) {
+        rayCount_ += verdict.rays;
+        const std::uint32_t r = task.r, s = task.s;
+        if (task.kind == Task::kSelf) {
+            if (hierarchy_[r].patch) return;  // flat: a patch does not see itself
+            const auto& children = hierarchy_[r].children;
+            for (auto i = children.rbegin(); i != children.rend(); ++i) {
+                stack.push_back({Task::kSelf, *i, *i});
+                for (auto j = children.rbegin(); j != children.rend(); ++j) {
+                    if (i != j) stack.push_back({Task::kPair, *i, *j});
+                }
+            }
+            return;
+        }
+        switch (verdict.kind) {
+            case Verdict::kNone:
+                return;
+            case Verdict::kLink:
+                if (task.kind == Task::kSource) {
+                    sourceLinks_[r].push_back({s, verdict.link.visibility});
+                } else {
+                    links_[r].push_back(verdict.link);
+                }
+                return;
+            case Verdict::kSplitReceiver:
+            case Verdict::kSplitSender: {
+                const bool receiver = verdict.kind == Verdict::kSplitReceiver;
+                SplitNode(receiver ? r : s);
+                const auto& children = hierarchy_[receiver ? r : s].children;
+                const Task::Kind kind = task.kind == Task::kSource ? Task::kSource : Task::kPair;
+                for (auto child = children.rbegin(); child != children.rend(); ++child) {
+                    stack.push_back({kind, receiver ? *child : r, receiver ? s : *child});
+                }
+                return;
+            }
+        }
+    }
+
+    Verdict JudgeSource(std::uint32_t r, std::uint32_t s) const {
         const DirectionalSource& source = sources_[s];
         double power = 0.0;
         for (int b = 0; b < bands_; ++b) power += source.normalIrradiance[b];
         const double unoccluded = power * ProjectedArea(r, source.toward);
-        if (unoccluded <= 0.0) return;
-        const double v = SourceVisibility(r, s);
+        if (unoccluded <= 0.0) return {};
+        Verdict verdict;
+        const double v = SourceVisibility(r, s, verdict.rays);
         const double error = unoccluded * VisibilitySpread(v, options_.visibilityRays);
-        if (error > options_.epsilon * totalPower_ && Splittable(r)) {
-            const std::vector<std::uint32_t> children = hierarchy_[r].children;
-            for (std::uint32_t child : children) RefineSource(child, s);
-            return;
+        if (error > options_.epsilon * totalPower_ && CanSplit(r)) {
+            verdict.kind = Verdict::kSplitReceiver;
+        } else if (v > 0.0) {
+            verdict.kind = Verdict::kLink;
+            verdict.link.visibility = static_cast<float>(v);
         }
-        if (v > 0.0) sourceLinks_[r].push_back({s, v});
+        return verdict;
     }
 
-    void RefineSelf(std::uint32_t c) {
-        if (hierarchy_[c].patch) return;  // flat: a patch does not see itself
-        const std::vector<std::uint32_t> children = hierarchy_[c].children;
-        for (std::uint32_t i : children) {
-            for (std::uint32_t j : children) {
-                if (i != j) RefinePair(i, j);
-            }
-            RefineSelf(i);
-        }
-    }
-
-    // Splits the larger of r and s (or the other when the larger cannot be split) and
-    // refines the pairs of parts; false when neither can be split.
-    bool Split(std::uint32_t r, std::uint32_t s) {
+    // Which of r and s a link between them splits: the larger, or the other when the
+    // larger cannot be split; none when neither can.
+    Verdict::Kind SplitChoice(std::uint32_t r, std::uint32_t s) const {
         const bool receiverLarger = hierarchy_[r].radius >= hierarchy_[s].radius;
-        if (receiverLarger ? Splittable(r) : Splittable(s)) {
-            SplitAndRefine(r, s, receiverLarger);
-            return true;
-        }
-        if (receiverLarger ? Splittable(s) : Splittable(r)) {
-            SplitAndRefine(r, s, !receiverLarger);
-            return true;
-        }
-        return false;
-    }
-
-    void SplitAndRefine(std::uint32_t r, std::uint32_t s, bool splitReceiver) {
-        const std::vector<std::uint32_t> children = hierarchy_[splitReceiver ? r : s].children;
-        for (std::uint32_t child : children) {
-            if (splitReceiver) {
-                RefinePair(child, s);
-            } else {
-                RefinePair(r, child);
-            }
-        }
+        const auto larger = receiverLarger ? Verdict::kSplitReceiver : Verdict::kSplitSender;
+        const auto smaller = receiverLarger ? Verdict::kSplitSender : Verdict::kSplitReceiver;
+        if (CanSplit(receiverLarger ? r : s)) return larger;
+        if (CanSplit(receiverLarger ? s : r)) return smaller;
+        return Verdict::kNone;
     }
 
     // R's area facing the light of a sender in direction ω, for the error estimate: its
@@ -521,20 +602,30 @@ class HrcSolver {
         return e;
     }
 
-    // Links s → r, or refines the pair when the link would carry more error than ε of the
+    // Links s → r, or splits the pair when the link would carry more error than ε of the
     // source power: a sender still dark is linked where it stands, and relinked by
     // Rerefine once it has lit up.
-    void RefinePair(std::uint32_t r, std::uint32_t s) {
+    Verdict JudgePair(std::uint32_t r, std::uint32_t s) const {
         const bool exact = hierarchy_[r].patch && hierarchy_[s].patch;
         const Estimate e = exact ? EstimateExact(r, s) : EstimatePair(r, s);
-        if (exact && !e.near && e.form.upper + e.form.lower <= 0.0) return;
+        if (exact && !e.near && e.form.upper + e.form.lower <= 0.0) return {};
         // Geometry alone may call for a split: then no visibility rays are spent on it.
         const double threshold = options_.epsilon * totalPower_;
-        if (e.power * e.geometricError + e.sideError > threshold && Split(r, s)) return;
-        const double v = Visibility(r, s);
-        if (Error(e, v) > threshold && Split(r, s)) return;
-        if (v <= 0.0 || (exact && e.form.upper + e.form.lower <= 0.0)) return;
-        NodeLink link;
+        if (e.power * e.geometricError + e.sideError > threshold) {
+            if (const auto split = SplitChoice(r, s); split != Verdict::kNone)
+                return {split, {}, 0};
+        }
+        Verdict verdict;
+        const double v = Visibility(r, s, verdict.rays);
+        if (Error(e, v) > threshold) {
+            if (const auto split = SplitChoice(r, s); split != Verdict::kNone) {
+                verdict.kind = split;
+                return verdict;
+            }
+        }
+        if (v <= 0.0 || (exact && e.form.upper + e.form.lower <= 0.0)) return verdict;
+        verdict.kind = Verdict::kLink;
+        NodeLink& link = verdict.link;
         link.sender = s;
         link.exact = exact;
         link.visibility = static_cast<float>(v);
@@ -549,7 +640,7 @@ class HrcSolver {
             link.receiverBins = Locate(directions_, e.toSender);
             link.senderBins = Locate(directions_, -e.toSender);
         }
-        links_[r].push_back(link);
+        return verdict;
     }
 
     // Refinement judges a link by the light its sender sends when it is made: a sender lit
@@ -559,27 +650,36 @@ class HrcSolver {
     // classic refine–solve loop of hierarchical radiosity). True when a link was split.
     bool Rerefine() {
         const double threshold = options_.epsilon * totalPower_;
-        bool split = false;
         const std::size_t count = links_.size();
-        for (std::uint32_t r = 0; r < count; ++r) {
-            if (links_[r].empty()) continue;
-            std::vector<NodeLink> kept, refine;
-            for (const NodeLink& link : links_[r]) {
-                const Estimate e =
-                    link.exact ? EstimateExact(r, link.sender) : EstimatePair(r, link.sender);
-                (Error(e, link.visibility) > threshold ? refine : kept).push_back(link);
-            }
-            if (refine.empty()) continue;
-            links_[r] = std::move(kept);
-            for (const NodeLink& link : refine) {
-                if (Split(r, link.sender)) {
-                    split = true;
+        // Per receiver, in parallel: the links that fail move to the end of its list.
+        std::vector<std::uint32_t> failing(count, 0);
+        tbb::parallel_for(std::size_t{0}, count, [&](std::size_t r) {
+            auto& links = links_[r];
+            const auto kept =
+                std::stable_partition(links.begin(), links.end(), [&](const NodeLink& link) {
+                    const Estimate e =
+                        link.exact ? EstimateExact(r, link.sender) : EstimatePair(r, link.sender);
+                    return Error(e, link.visibility) <= threshold;
+                });
+            failing[r] = static_cast<std::uint32_t>(links.end() - kept);
+        });
+        std::vector<Task> stack;
+        for (std::uint32_t r = count; r-- > 0;) {
+            auto& links = links_[r];
+            std::vector<NodeLink> unsplittable;  // neither end can be split: the link stays
+            for (std::size_t i = links.size(); i-- > links.size() - failing[r];) {
+                if (SplitChoice(r, links[i].sender) == Verdict::kNone) {
+                    unsplittable.push_back(links[i]);
                 } else {
-                    links_[r].push_back(link);  // neither can be split: the link stays
+                    stack.push_back({Task::kSplit, r, links[i].sender});
                 }
             }
+            links.resize(links.size() - failing[r]);
+            links.insert(links.end(), unsplittable.rbegin(), unsplittable.rend());
         }
-        return split;
+        if (stack.empty()) return false;
+        Refine(std::move(stack));
+        return true;
     }
 
     // ---- Solution -----------------------------------------------------------------------
@@ -601,17 +701,16 @@ class HrcSolver {
         return deepest;
     }
     void Gather();
-    // Light gathered by a node and its ancestors, handed down to the patches.
-    struct Level {
-        std::vector<double> bins;     // [bin][band], normal irradiance
-        std::vector<double> sources;  // visibility, per directional source
-        Sided sides{};
-        Spectrum integral{};
-        Moment moment{};
-    };
-    void Accumulate(std::uint32_t n, bool sourcesOnly, Level& level) const;
-    void PushDown(bool sourcesOnly);
-    void PushSubtree(std::uint32_t start, const Level& above, bool sourcesOnly);
+    // Handing light down to the leaf patches. Descend visits the leaf patches under
+    // `start` with the sum of what their ancestors hold: `above` plus, for every ancestor
+    // n with holds(n), what add(n, sum) adds; sums are copied only at such nodes.
+    template <class Holds, class Add, class Leaf>
+    void Descend(std::uint32_t start, const std::vector<double>& above, Holds holds, Add add,
+                 Leaf leaf) const;
+    // Per leaf patch, the light of the directional sources (after each Index).
+    void PushSources();
+    // Per leaf patch, the source light plus what the clusters and patches above gathered.
+    void PushDown();
     double UpdateRadiosity();
     void Extrapolate(double factor);
     void Outputs(Solution& solution);
@@ -647,7 +746,10 @@ class HrcSolver {
     std::vector<std::uint32_t> receivers_;                       // nodes with links
     // Leaf patches: the light of the last push.
     std::vector<Sided> irradiance_, direct_;
-    std::vector<Sided> change_;  // leaf patches: of the last sweep
+    std::vector<Sided> change_;       // leaf patches: of the last sweep
+    std::vector<Sided> sourceSides_;  // leaf patches: the light of the directional sources
+    std::vector<Spectrum> sourceIntegral_;
+    std::vector<Moment> sourceMoment_;
     std::vector<Spectrum> integral_;
     std::vector<Moment> moment_;
     std::vector<Spectrum> emission_;  // exitance of emitter patches
@@ -722,6 +824,7 @@ void HrcSolver<kBands>::Index() {
     for (std::uint32_t n = 0; n < size; ++n) {
         if (!links_[n].empty()) receivers_.push_back(n);
     }
+    PushSources();
 }
 
 template <int kBands>
@@ -831,82 +934,114 @@ void HrcSolver<kBands>::Gather() {
 }
 
 template <int kBands>
-void HrcSolver<kBands>::Accumulate(std::uint32_t n, bool sourcesOnly, Level& level) const {
-    const HrcNode& node = hierarchy_[n];
-    for (const SourceLink& link : sourceLinks_[n]) level.sources[link.source] += link.visibility;
-    if (sourcesOnly) return;
-    if (node.patch) {
-        for (int k = 0; k < bands_; ++k) {
-            level.sides[kUpper][k] += gatheredSides_[n][kUpper][k];
-            level.sides[kLower][k] += gatheredSides_[n][kLower][k];
-            level.integral[k] += gatheredIntegral_[n][k];
-            level.moment[k] += gatheredMoment_[n][k];
+template <class Holds, class Add, class Leaf>
+void HrcSolver<kBands>::Descend(std::uint32_t start, const std::vector<double>& above, Holds holds,
+                                Add add, Leaf leaf) const {
+    // Depth-first; sums[k] is written only by a node of depth k that holds something, and
+    // read by its descendants, so a sibling's subtree never overwrites a sum still in use.
+    struct Entry {
+        std::uint32_t node;
+        int depth, sum;
+    };
+    std::vector<std::vector<double>> sums = {above};
+    std::vector<Entry> stack = {{start, 1, 0}};
+    while (!stack.empty()) {
+        const Entry entry = stack.back();
+        stack.pop_back();
+        int sum = entry.sum;
+        if (holds(entry.node)) {
+            if (static_cast<int>(sums.size()) <= entry.depth) sums.resize(entry.depth + 1);
+            sums[entry.depth] = sums[entry.sum];
+            add(entry.node, sums[entry.depth]);
+            sum = entry.depth;
         }
-    } else {
-        const double* in = &gatheredBins_[static_cast<std::size_t>(slot_[n]) * bins_ * bands_];
-        for (int i = 0; i < bins_ * bands_; ++i) level.bins[i] += in[i];
+        const HrcNode& node = hierarchy_[entry.node];
+        if (node.children.empty()) {
+            if (node.patch) leaf(entry.node, sums[sum]);
+            continue;
+        }
+        for (std::uint32_t child : node.children) stack.push_back({child, entry.depth + 1, sum});
     }
 }
 
 template <int kBands>
-void HrcSolver<kBands>::PushDown(bool sourcesOnly) {
-    // What the root gathered, then each of its subtrees in parallel: they share nothing.
-    Level top{std::vector<double>(bins_ * bands_, 0.0), std::vector<double>(sources_.size(), 0.0)};
+void HrcSolver<kBands>::PushSources() {
+    const std::size_t size = hierarchy_.Size();
+    sourceSides_.assign(size, Sided{});
+    sourceIntegral_.assign(size, Spectrum{});
+    sourceMoment_.assign(size, Moment{});
+    const auto holds = [&](std::uint32_t n) { return !sourceLinks_[n].empty(); };
+    const auto add = [&](std::uint32_t n, std::vector<double>& visibility) {
+        for (const SourceLink& link : sourceLinks_[n]) visibility[link.source] += link.visibility;
+    };
+    const auto leaf = [&](std::uint32_t n, const std::vector<double>& visibility) {
+        const HrcNode& node = hierarchy_[n];
+        for (std::size_t s = 0; s < sources_.size(); ++s) {
+            if (visibility[s] <= 0.0) continue;
+            const double cosine = glm::dot(node.normal, sources_[s].toward);
+            const int side = cosine > 0.0 ? kUpper : kLower;
+            if (Inner(node.triangle, side)) continue;
+            for (int k = 0; k < bands_; ++k) {
+                const double normal = sources_[s].normalIrradiance[k] * visibility[s];
+                sourceSides_[n][side][k] += normal * std::abs(cosine);
+                sourceIntegral_[n][k] += normal;
+                sourceMoment_[n][k] += normal * sources_[s].toward;
+            }
+        }
+    };
     const std::uint32_t root = hierarchy_.Root();
-    if (hierarchy_[root].patch) return PushSubtree(root, top, sourcesOnly);
-    Accumulate(root, sourcesOnly, top);
+    std::vector<double> top(sources_.size(), 0.0);
+    if (hierarchy_[root].patch) return Descend(root, top, holds, add, leaf);
+    add(root, top);
     const auto& children = hierarchy_[root].children;
     tbb::parallel_for(std::size_t{0}, children.size(),
-                      [&](std::size_t i) { PushSubtree(children[i], top, sourcesOnly); });
+                      [&](std::size_t i) { Descend(children[i], top, holds, add, leaf); });
 }
 
 template <int kBands>
-void HrcSolver<kBands>::PushSubtree(std::uint32_t start, const Level& above, bool sourcesOnly) {
-    // Depth-first with one accumulator per depth: what every ancestor gathered.
-    std::vector<Level> levels = {above};
-    std::vector<std::pair<std::uint32_t, int>> stack = {{start, 1}};
-    while (!stack.empty()) {
-        const auto [n, depth] = stack.back();
-        stack.pop_back();
-        if (static_cast<int>(levels.size()) <= depth) levels.push_back(levels.front());
-        Level& level = levels[depth];
-        level = levels[depth - 1];
-        Accumulate(n, sourcesOnly, level);
+void HrcSolver<kBands>::PushDown() {
+    const auto holds = [&](std::uint32_t n) { return !hierarchy_[n].patch && !links_[n].empty(); };
+    const auto add = [&](std::uint32_t n, std::vector<double>& bins) {
+        const double* in = &gatheredBins_[static_cast<std::size_t>(slot_[n]) * bins_ * bands_];
+        for (int i = 0; i < bins_ * bands_; ++i) bins[i] += in[i];
+    };
+    const auto leaf = [&](std::uint32_t n, const std::vector<double>& bins) {
         const HrcNode& node = hierarchy_[n];
-        if (!node.patch || !node.children.empty()) {
-            for (std::uint32_t child : node.children) stack.push_back({child, depth + 1});
-            continue;
+        Sided e = sourceSides_[n];
+        Spectrum integral = sourceIntegral_[n];
+        Moment moment = sourceMoment_[n];
+        // What the patch and the patches it was split from gathered.
+        for (std::uint32_t m = n; m != kNoNode && hierarchy_[m].patch; m = hierarchy_[m].parent) {
+            for (int k = 0; k < bands_; ++k) {
+                e[kUpper][k] += gatheredSides_[m][kUpper][k];
+                e[kLower][k] += gatheredSides_[m][kLower][k];
+                integral[k] += gatheredIntegral_[m][k];
+                moment[k] += gatheredMoment_[m][k];
+            }
         }
-        // A leaf patch: everything arriving, per side.
-        Sided e = level.sides;
-        Spectrum integral = level.integral;
-        auto moment = level.moment;
         for (int d = 0; d < bins_; ++d) {
             const glm::dvec3& omega = directions_.Direction(d);
             const double cosine = glm::dot(node.normal, omega);
-            if (Inner(node.triangle, cosine > 0.0 ? kUpper : kLower)) continue;
+            const int side = cosine > 0.0 ? kUpper : kLower;
+            if (Inner(node.triangle, side)) continue;
             for (int k = 0; k < bands_; ++k) {
-                const double normal = level.bins[d * bands_ + k];
-                e[cosine > 0.0 ? kUpper : kLower][k] += normal * std::abs(cosine);
+                const double normal = bins[d * bands_ + k];
+                e[side][k] += normal * std::abs(cosine);
                 integral[k] += normal;
                 moment[k] += normal * omega;
-            }
-        }
-        for (std::size_t s = 0; s < sources_.size(); ++s) {
-            if (level.sources[s] <= 0.0) continue;
-            const double cosine = glm::dot(node.normal, sources_[s].toward);
-            if (Inner(node.triangle, cosine > 0.0 ? kUpper : kLower)) continue;
-            for (int k = 0; k < bands_; ++k) {
-                const double normal = sources_[s].normalIrradiance[k] * level.sources[s];
-                e[cosine > 0.0 ? kUpper : kLower][k] += normal * std::abs(cosine);
-                integral[k] += normal;
-                moment[k] += normal * sources_[s].toward;
             }
         }
         irradiance_[n] = e;
         integral_[n] = integral;
         moment_[n] = moment;
-    }
+    };
+    const std::uint32_t root = hierarchy_.Root();
+    std::vector<double> top(bins_ * bands_, 0.0);
+    if (hierarchy_[root].patch) return Descend(root, top, holds, add, leaf);
+    if (holds(root)) add(root, top);
+    const auto& children = hierarchy_[root].children;
+    tbb::parallel_for(std::size_t{0}, children.size(),
+                      [&](std::size_t i) { Descend(children[i], top, holds, add, leaf); });
 }
 
 template <int kBands>
@@ -973,12 +1108,16 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
     if (totalPower_ <= 0.0) return Outputs(solution);
 
     Stopwatch clock;
-    for (std::uint32_t s = 0; s < sources_.size(); ++s) RefineSource(hierarchy_.Root(), s);
+    std::vector<Task> sourceTasks;
+    for (std::uint32_t s = sources_.size(); s-- > 0;) {
+        sourceTasks.push_back({Task::kSource, hierarchy_.Root(), s});
+    }
+    Refine(std::move(sourceTasks));
     // Direct light first, so that links are refined on what senders will send; with
     // direct light only, lamps are the only senders and their links the only ones needed.
     Index();
     if (!options_.directOnly) {
-        PushDown(true);
+        PushDown();
         UpdateRadiosity();
     }
     PullUp();
@@ -987,7 +1126,8 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
         return std::any_of(emission_[n].begin(), emission_[n].begin() + bands_,
                            [](double e) { return e > 0.0; });
     });
-    if (!options_.directOnly || lamps) RefineSelf(hierarchy_.Root());
+    if (!options_.directOnly || lamps)
+        Refine({{Task::kSelf, hierarchy_.Root(), hierarchy_.Root()}});
     Index();
     const double refineSeconds = clock.Lap();
 
@@ -1006,9 +1146,10 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
         // Light to a few percent is all that refinement needs.
         const double tolerance = last ? options_.tolerance : std::max(options_.tolerance, 1e-2);
         convergence = Convergence{};
-        for (int sweep = 0; iteration < iterations; ++iteration, ++sweep) {
+        int sweep = 0;
+        for (; iteration < iterations; ++iteration, ++sweep) {
             Gather();
-            PushDown(false);
+            PushDown();
             if (iteration == 0) direct_ = irradiance_;
             residual = UpdateRadiosity();
             if (const double factor = convergence.Step(residual); factor > 0.0) {
@@ -1020,18 +1161,22 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
                 (!last && sweep == kSweepsBeforeRerefining))
                 break;
         }
-        if (last) break;
+        const double sweepSeconds = clock.Lap();
+        if (last) {
+            spdlog::debug("hrc: pass {}: {} sweeps {:.3f} s", pass, sweep + 1, sweepSeconds);
+            break;
+        }
         settled = !Rerefine();
         if (!settled) Index();
+        spdlog::debug("hrc: pass {}: {} sweeps {:.3f} s, links judged again {:.3f} s", pass,
+                      sweep + 1, sweepSeconds, clock.Lap());
         ++iteration;
     }
     solution.stats.iterations = std::min(iteration + 1, iterations);
     solution.stats.residual = convergence.Remaining(residual);
-    const double solveSeconds = clock.Lap();
     Outputs(solution);
-    spdlog::debug(
-        "hrc: source links {:.3f} s, refinement {:.3f} s, {} iterations {:.3f} s, outputs {:.3f} s",
-        sourceSeconds, refineSeconds, iteration + 1, solveSeconds, clock.Lap());
+    spdlog::debug("hrc: source links {:.3f} s, refinement {:.3f} s, outputs {:.3f} s",
+                  sourceSeconds, refineSeconds, clock.Lap());
 }
 
 template <int kBands>

@@ -7,16 +7,18 @@
 // (DirectionSet, §4.2.2) and the receiver's incoming light kept per direction, so that
 // clusters emit and receive as volumes with no assumption of flatness. A link between
 // two patches uses the analytic point-to-polygon form factor, bounded in the near field.
-// Visibility is the unoccluded fraction of deterministic stratified rays through Embree.
+// Visibility is the unoccluded fraction of deterministic stratified rays through Embree,
+// each ray weighted by the form factor's kernel.
 //
 // Refinement: a link is split (the larger node, or a patch subdivided into four) while its
 // estimated error — the power it carries times its geometric error ((r_R + r_S)/d)² plus
 // its visibility spread 2√(v(1−v)) — exceeds ε times the power the sources bring into the
-// scene. Solution: Jacobi gathering with push/pull (B₁ = ρ₁I₁ + τ₂→₁I₂, B₂ = ρ₂I₂ + τ₁→₂I₁;
-// what is pulled up is the intensity of both sides), accelerated by extrapolating the
-// geometric series of the changes and iterated until the change still to come is below
-// the tolerance; between solutions every link is judged again with the light found
-// (refine–solve passes), so that senders dark when first linked are refined too.
+// scene; the candidate links are judged in parallel chunks and the verdicts carried out in
+// order, so the links do not depend on the number of threads. Solution: Jacobi gathering with
+// push/pull (B₁ = ρ₁I₁ + τ₂→₁I₂, B₂ = ρ₂I₂ + τ₁→₂I₁; what is pulled up is the intensity of both
+// sides), accelerated by extrapolating the geometric series of the changes and iterated until the
+// change still to come is below the tolerance; between solutions every link is judged again with
+// the light found (refine–solve passes), so that senders dark when first linked are refined too.
 #pragma once
 
 #include <cstdint>
