@@ -168,6 +168,8 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
         hrcSetting += " subdivision=" + std::to_string(options.hrc.maxSubdivision);
     if (options.hrc.visibilityRays != defaults.visibilityRays)
         hrcSetting += " rays=" + std::to_string(options.hrc.visibilityRays);
+    if (options.hrc.sourceRays != defaults.sourceRays)
+        hrcSetting += " source-rays=" + std::to_string(options.hrc.sourceRays);
     if (options.hrc.directionLevel != defaults.directionLevel)
         hrcSetting += " directions=" + std::to_string(options.hrc.directionLevel);
     for (int samples : options.monteCarloSamples) {

@@ -27,7 +27,7 @@ struct SolveCommand {
     std::string scene, solver = "mc", out, structures, ply;
     int samples = 1024, replicates = 16, threads = 0;
     double epsilon = 1e-4;
-    int subdivision = 3, visibilityRays = 8, directionLevel = 2;
+    int subdivision = 3, visibilityRays = 8, sourceRays = 32, directionLevel = 2;
     std::uint64_t seed = 1;
     bool directOnly = false, quiet = false;
 };
@@ -46,6 +46,7 @@ int RunSolve(const SolveCommand& command) {
     settings.hrc.threads = command.threads;
     settings.hrc.maxSubdivision = command.subdivision;
     settings.hrc.visibilityRays = command.visibilityRays;
+    settings.hrc.sourceRays = command.sourceRays;
     settings.hrc.directionLevel = command.directionLevel;
     settings.monteCarlo.directOnly = settings.hrc.directOnly = command.directOnly;
     if (!command.quiet) {
@@ -254,6 +255,10 @@ int main(int argc, char** argv) {
                      "hrc: rays estimating each link's visibility")
         ->check(CLI::Range(1, 1024));
     solveApp
+        ->add_option("--source-rays", solve.sourceRays,
+                     "hrc: rays estimating the visibility of each link from a sun or sky cone")
+        ->check(CLI::Range(1, 1024));
+    solveApp
         ->add_option("--direction-level", solve.directionLevel,
                      "hrc: direction set of cluster light, 0..4 (4, 10, 34, 130, 514 directions)")
         ->check(CLI::Range(0, 4));
@@ -414,6 +419,10 @@ int main(int argc, char** argv) {
     errorApp
         ->add_option("--hrc-visibility-rays", errorBench.hrc.visibilityRays,
                      "HRC runs: rays estimating each link's visibility")
+        ->check(CLI::Range(1, 1024));
+    errorApp
+        ->add_option("--hrc-source-rays", errorBench.hrc.sourceRays,
+                     "HRC runs: rays estimating each link's visibility from a sun or sky cone")
         ->check(CLI::Range(1, 1024));
     errorApp
         ->add_option("--hrc-direction-level", errorBench.hrc.directionLevel,

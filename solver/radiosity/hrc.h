@@ -31,8 +31,11 @@ namespace leaflux {
 struct HrcOptions {
     // Largest error a link may carry, as a fraction of the power the sources bring in.
     double epsilon = 1e-4;
-    int maxSubdivision = 3;   // a triangle splits into at most 4^this patches
-    int visibilityRays = 8;   // per link (stratified pairs of points)
+    int maxSubdivision = 3;  // a triangle splits into at most 4^this patches
+    int visibilityRays = 8;  // per link (stratified pairs of points)
+    // Per link from a sun or a sky cone: direct light is most of what a leaf gets, and
+    // there are few such links.
+    int sourceRays = 32;
     int directionLevel = 2;   // direction set of cluster light: 2 → 34 directions
     double tolerance = 1e-5;  // iteration stops when the change still to come is less
                               // than this times the largest radiosity
