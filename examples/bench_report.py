@@ -6,6 +6,7 @@ README between its `<!-- report:NAME -->` and `<!-- /report:NAME -->` markers, s
 the README says what the last run measured and nothing else (one section per scene).
 
 Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,scaling,growth] [--scenes a,b]
+                      [--scaling-solvers hrc,mc]
 The growth part reads the demo's out/demo/growth_comparison.csv (run scripts/demo.sh).
 """
 import argparse
@@ -107,8 +108,9 @@ def error_section(build, out, name, run=True):
     return "\n".join(table)
 
 
-def scaling_section(build, out):
-    subprocess.run([sys.executable, os.path.join(HERE, "bench_scaling.py"), build, out], check=True)
+def scaling_section(build, out, solvers):
+    subprocess.run([sys.executable, os.path.join(HERE, "bench_scaling.py"), build, out, "--solvers", solvers],
+                   check=True)
     for name in ("scaling.csv", "scaling.png", "fits.csv"):
         shutil.copy(os.path.join(out, name), os.path.join(REPORT, name))
     rows = list(csv.DictReader(open(os.path.join(out, "scaling.csv"))))
@@ -150,6 +152,8 @@ def main():
     parser.add_argument("out")
     parser.add_argument("--only", default="error,scaling,growth")
     parser.add_argument("--scenes", default=",".join(SCENES))
+    parser.add_argument("--scaling-solvers", default="hrc,mc",
+                        help="solvers the scaling run measures; the others' rows are kept from OUT_DIR")
     parser.add_argument("--demo", default=os.path.join(ROOT, "out", "demo"))
     parser.add_argument("--tables-only", action="store_true",
                         help="rewrite the error tables from the CSVs in OUT_DIR, run nothing")
@@ -164,7 +168,7 @@ def main():
             update_readme(f"error-{name}",
                           error_section(build, os.path.join(out, "error"), name, not args.tables_only))
     if "scaling" in parts:
-        update_readme("scaling", scaling_section(build, os.path.join(out, "scaling")))
+        update_readme("scaling", scaling_section(build, os.path.join(out, "scaling"), args.scaling_solvers))
     if "growth" in parts:
         update_readme("growth", growth_section(args.demo))
     print(f"README.md sections {args.only} rewritten; files in {REPORT}")

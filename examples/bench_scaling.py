@@ -43,7 +43,20 @@ def main():
     parser.add_argument("--trees", default="1,4,16,64,233")
     parser.add_argument("--epsilon", default="1e-5")
     parser.add_argument("--samples", default="256")
+    parser.add_argument("--solvers", default="hrc,mc",
+                        help="solvers to run; the rows of the others are kept from OUT/scaling.csv")
     args = parser.parse_args()
+    run_solvers = args.solvers.split(",")
+    kept = {}
+    previous = os.path.join(args.out, "scaling.csv")
+    if os.path.exists(previous):
+        for r in csv.DictReader(open(previous)):
+            if r["solver"] not in run_solvers:
+                for key in ("leaves", "trees", "links", "elements"):
+                    r[key] = int(r[key]) if r[key] else ""
+                for key in ("wall_s", "cpu_s", "peak_mib"):
+                    r[key] = float(r[key]) if r[key] else ""
+                kept[(r["series"], r["leaves"], r["solver"])] = r
     leaflux = os.path.join(args.build, "server", "leaflux")
     os.makedirs(args.out, exist_ok=True)
     scenes = [("one tree", int(n), 1, lambda n=int(n): generate_tree(leaflux, args.out, n))
@@ -54,6 +67,10 @@ def main():
     for series, leaves, trees, make in scenes:
         scene = make()
         for solver, options in (("hrc", ["--epsilon", args.epsilon]), ("mc", ["--samples", args.samples])):
+            if solver not in run_solvers:
+                if (series, leaves, solver) in kept:
+                    rows.append(kept[(series, leaves, solver)])
+                continue
             row = dict(series=series, leaves=leaves, trees=trees, solver=solver, setting=options[1])
             try:
                 result = solve(leaflux, scene, os.path.join(args.out, f"{series[0]}{leaves}_{solver}.csv"),
