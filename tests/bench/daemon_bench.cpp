@@ -3,6 +3,8 @@
 // outputs) and the latency of cycles of a plant growing to 1,000
 // and 10,000 leaves (HRC, ε = 1e-4), one tenth of the plant added per cycle.
 // Run: build/release/tests/leaflux_bench_daemon [out.csv]
+#include <spdlog/cfg/env.h>
+
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -84,6 +86,7 @@ struct Row {
 
 int main(int argc, char** argv) {
     using namespace leaflux;
+    spdlog::cfg::load_env_levels();  // SPDLOG_LEVEL=debug shows the solver's phases
     std::vector<Row> rows;
     Loopback daemon;
     {
