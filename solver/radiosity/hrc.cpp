@@ -585,10 +585,25 @@ class HrcSolver {
         const HrcNode& R = hierarchy_[r];
         const HrcNode& S = hierarchy_[s];
         Estimate e;
-        const glm::dvec3 x = (R.a + R.b + R.c) / 3.0;
+        const glm::dvec3 x = (R.a + R.b + R.c) / 3.0, y = (S.a + S.b + S.c) / 3.0;
         e.form = PointToTriangle(x, R.normal, S.a, S.b, S.c);
-        e.senderSide = glm::dot(S.normal, x - (S.a + S.b + S.c) / 3.0) >= 0.0 ? kUpper : kLower;
-        e.toSender = glm::normalize((S.a + S.b + S.c) / 3.0 - x);
+        e.senderSide = glm::dot(S.normal, x - y) >= 0.0 ? kUpper : kLower;
+        e.toSender = glm::normalize(y - x);
+        if (S.areaM2 < R.areaM2 / 16.0) {
+            // A sender much smaller than R (two subdivision levels or more) is better judged
+            // from its own centre: by reciprocity R's mean F is A_S F(y → R) / A_R, which
+            // never lets R take more than S sends. From R's centre, a 1 cm leaf patch 1 mm
+            // over a 2 mm lamp patch took 12 times what the lamp patch emits. The light
+            // lands on R's side facing y; its solid angle keeps the ratio to F it had.
+            const SidedFormFactor back = PointToTriangle(y, S.normal, R.a, R.b, R.c);
+            const double form =
+                (e.senderSide == kUpper ? back.upper : back.lower) * S.areaM2 / R.areaM2;
+            const double before = e.form.upper + e.form.lower;
+            const bool upper = glm::dot(R.normal, y - x) >= 0.0;
+            e.form.solidAngleSr = before > 0.0 ? e.form.solidAngleSr * form / before : kPi * form;
+            e.form.upper = upper ? form : 0.0;
+            e.form.lower = upper ? 0.0 : form;
+        }
         const double d = std::max(glm::length(S.centroid - R.centroid), 1e-300);
         // The form factor at R's centroid speaks for all of R only when R is small against
         // the distance; otherwise parts of R may see S fully (F up to 1 on each side).
