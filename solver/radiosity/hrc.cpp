@@ -10,6 +10,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <queue>
 #include <unordered_map>
 
 #include "solver/check.h"
@@ -711,6 +712,8 @@ class HrcSolver {
 
     void Solve(Solution& solution);
     void Index();
+    // The subtrees swept in parallel and the nodes above them.
+    void Share();
     void PullUp();
     void PullNode(std::uint32_t n);
     // Levels from the root to the deepest node with a link.
@@ -732,6 +735,10 @@ class HrcSolver {
     template <class Holds, class Add, class Leaf>
     void Descend(std::uint32_t start, const std::vector<double>& above, Holds holds, Add add,
                  Leaf leaf) const;
+    // Descend over every subtree of Share in parallel, each from the sum of what the nodes
+    // above it hold (sums of `width` numbers).
+    template <class Holds, class Add, class Leaf>
+    void DescendAll(std::size_t width, Holds holds, Add add, Leaf leaf) const;
     // Per leaf patch, the light of the directional sources (after each Index).
     void PushSources();
     // Per leaf patch, the source light plus what the clusters and patches above gathered.
@@ -766,9 +773,10 @@ class HrcSolver {
     std::vector<Spectrum> gatheredIntegral_;  // patches: ∫ L dω
     std::vector<Moment> gatheredMoment_;
     std::vector<std::uint32_t> preOrder_;                        // parents before children
-    std::vector<std::pair<std::size_t, std::size_t>> subtrees_;  // the root's, in preOrder_
-    std::vector<std::uint32_t> leaves_;                          // leaf patches
-    std::vector<std::uint32_t> receivers_;                       // nodes with links
+    std::vector<std::pair<std::size_t, std::size_t>> subtrees_;  // ranges of preOrder_
+    std::vector<std::uint32_t> above_;      // the nodes above the subtrees, in pre-order
+    std::vector<std::uint32_t> leaves_;     // leaf patches
+    std::vector<std::uint32_t> receivers_;  // nodes with links
     // Leaf patches: the light of the last push.
     std::vector<Sided> irradiance_, direct_;
     std::vector<Sided> change_;       // leaf patches: of the last sweep
@@ -792,17 +800,11 @@ void HrcSolver<kBands>::Index() {
         for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);
     }
     Grow();
-    subtrees_.clear();
     leaves_.clear();
-    for (std::size_t i = 1; i < preOrder_.size(); ++i) {
-        const std::uint32_t n = preOrder_[i];
-        if (hierarchy_[n].parent == preOrder_.front()) {
-            if (!subtrees_.empty()) subtrees_.back().second = i;
-            subtrees_.push_back({i, preOrder_.size()});
-        }
+    for (std::uint32_t n : preOrder_) {
         if (hierarchy_[n].patch && hierarchy_[n].children.empty()) leaves_.push_back(n);
     }
-    if (preOrder_.size() == 1 && hierarchy_[preOrder_[0]].patch) leaves_.push_back(preOrder_[0]);
+    Share();
     if (slot_.empty()) {
         // Clusters never change after construction: their slots and projected areas once.
         slot_.assign(hierarchy_.Size(), kNoNode);
@@ -853,14 +855,59 @@ void HrcSolver<kBands>::Index() {
 }
 
 template <int kBands>
+void HrcSolver<kBands>::Share() {
+    // A tree under a one-plant root has one big subtree: the largest subtree is split into
+    // its children until there are enough to keep every thread busy.
+    constexpr std::size_t kSubtrees = 64;
+    const std::size_t size = hierarchy_.Size();
+    std::vector<std::size_t> position(size, 0), extent(size, 1);  // pre-order index, nodes
+    for (std::size_t i = 0; i < preOrder_.size(); ++i) position[preOrder_[i]] = i;
+    for (std::size_t i = preOrder_.size(); i-- > 1;) {
+        extent[hierarchy_[preOrder_[i]].parent] += extent[preOrder_[i]];
+    }
+    std::priority_queue<std::pair<std::size_t, std::uint32_t>> largest;
+    largest.push({extent[preOrder_.front()], preOrder_.front()});
+    while (largest.size() < kSubtrees && !hierarchy_[largest.top().second].children.empty()) {
+        const std::uint32_t n = largest.top().second;
+        largest.pop();
+        for (std::uint32_t child : hierarchy_[n].children) largest.push({extent[child], child});
+    }
+    subtrees_.clear();
+    for (; !largest.empty(); largest.pop()) {
+        const std::uint32_t n = largest.top().second;
+        subtrees_.push_back({position[n], position[n] + extent[n]});
+    }
+    std::sort(subtrees_.begin(), subtrees_.end());
+    above_.clear();
+    std::size_t next = 0;
+    for (const auto& [first, last] : subtrees_) {
+        for (; next < first; ++next) above_.push_back(preOrder_[next]);
+        next = last;
+    }
+}
+
+template <int kBands>
+template <class Holds, class Add, class Leaf>
+void HrcSolver<kBands>::DescendAll(std::size_t width, Holds holds, Add add, Leaf leaf) const {
+    tbb::parallel_for(std::size_t{0}, subtrees_.size(), [&](std::size_t t) {
+        const std::uint32_t start = preOrder_[subtrees_[t].first];
+        std::vector<double> above(width, 0.0);
+        for (std::uint32_t m = hierarchy_[start].parent; m != kNoNode; m = hierarchy_[m].parent) {
+            if (holds(m)) add(m, above);
+        }
+        Descend(start, above, holds, add, leaf);
+    });
+}
+
+template <int kBands>
 void HrcSolver<kBands>::PullUp() {
-    // Children before parents: each subtree of the root in parallel (a pre-order range of
-    // its own), then the root.
+    // Children before parents: the subtrees in parallel (each a pre-order range of its
+    // own), then the nodes above them.
     emitted_.resize(hierarchy_.Size(), 0.0);
     tbb::parallel_for(std::size_t{0}, subtrees_.size(), [&](std::size_t t) {
         for (std::size_t i = subtrees_[t].second; i-- > subtrees_[t].first;) PullNode(preOrder_[i]);
     });
-    PullNode(preOrder_.front());
+    for (auto it = above_.rbegin(); it != above_.rend(); ++it) PullNode(*it);
 }
 
 template <int kBands>
@@ -1023,13 +1070,7 @@ void HrcSolver<kBands>::PushSources() {
             }
         }
     };
-    const std::uint32_t root = hierarchy_.Root();
-    std::vector<double> top(sources_.size(), 0.0);
-    if (hierarchy_[root].patch) return Descend(root, top, holds, add, leaf);
-    add(root, top);
-    const auto& children = hierarchy_[root].children;
-    tbb::parallel_for(std::size_t{0}, children.size(),
-                      [&](std::size_t i) { Descend(children[i], top, holds, add, leaf); });
+    DescendAll(sources_.size(), holds, add, leaf);
 }
 
 template <int kBands>
@@ -1069,13 +1110,7 @@ void HrcSolver<kBands>::PushDown() {
         integral_[n] = integral;
         moment_[n] = moment;
     };
-    const std::uint32_t root = hierarchy_.Root();
-    std::vector<double> top(bins_ * bands_, 0.0);
-    if (hierarchy_[root].patch) return Descend(root, top, holds, add, leaf);
-    if (holds(root)) add(root, top);
-    const auto& children = hierarchy_[root].children;
-    tbb::parallel_for(std::size_t{0}, children.size(),
-                      [&](std::size_t i) { Descend(children[i], top, holds, add, leaf); });
+    DescendAll(bins_ * bands_, holds, add, leaf);
 }
 
 template <int kBands>
