@@ -27,10 +27,27 @@ struct SolveCommand {
     std::string scene, solver = "mc", out, structures, ply;
     int samples = 1024, replicates = 16, threads = 0;
     double epsilon = 1e-4;
-    int subdivision = 3, visibilityRays = 8, sourceRays = 32, directionLevel = 2;
+    HrcOptions hrc;  // subdivision, rays and directions; ε and threads are set apart
     std::uint64_t seed = 1;
     bool directOnly = false, quiet = false;
 };
+
+// HRC's settings besides ε, as options named `prefix` + name, their help after `label`.
+void AddHrcSettings(CLI::App& app, HrcOptions& hrc, const std::string& prefix,
+                    const std::string& label) {
+    app.add_option(prefix + "subdivision", hrc.maxSubdivision,
+                   label + "times a triangle may be split in four")
+        ->check(CLI::Range(0, 8));
+    app.add_option(prefix + "visibility-rays", hrc.visibilityRays,
+                   label + "rays estimating each link's visibility")
+        ->check(CLI::Range(1, 1024));
+    app.add_option(prefix + "source-rays", hrc.sourceRays,
+                   label + "rays estimating the visibility of each link from a sun or sky cone")
+        ->check(CLI::Range(1, 1024));
+    app.add_option(prefix + "direction-level", hrc.directionLevel,
+                   label + "direction set of cluster light, 0..4 (4, 10, 34, 130, 514 directions)")
+        ->check(CLI::Range(0, 4));
+}
 
 int RunSolve(const SolveCommand& command) {
     const auto start = std::chrono::steady_clock::now();
@@ -42,12 +59,9 @@ int RunSolve(const SolveCommand& command) {
     settings.monteCarlo.seed = command.seed;
     settings.monteCarlo.threads = command.threads;
     settings.kind = command.solver == "hrc" ? SolverKind::kHrc : SolverKind::kMonteCarlo;
+    settings.hrc = command.hrc;
     settings.hrc.epsilon = command.epsilon;
     settings.hrc.threads = command.threads;
-    settings.hrc.maxSubdivision = command.subdivision;
-    settings.hrc.visibilityRays = command.visibilityRays;
-    settings.hrc.sourceRays = command.sourceRays;
-    settings.hrc.directionLevel = command.directionLevel;
     settings.monteCarlo.directOnly = settings.hrc.directOnly = command.directOnly;
     if (!command.quiet) {
         spdlog::info(
@@ -246,22 +260,7 @@ int main(int argc, char** argv) {
             "--epsilon", solve.epsilon,
             "hrc: largest error of a link, as a fraction of the power the sources bring in")
         ->check(CLI::Range(1e-9, 1.0));
-    solveApp
-        ->add_option("--subdivision", solve.subdivision,
-                     "hrc: times a triangle may be split in four")
-        ->check(CLI::Range(0, 8));
-    solveApp
-        ->add_option("--visibility-rays", solve.visibilityRays,
-                     "hrc: rays estimating each link's visibility")
-        ->check(CLI::Range(1, 1024));
-    solveApp
-        ->add_option("--source-rays", solve.sourceRays,
-                     "hrc: rays estimating the visibility of each link from a sun or sky cone")
-        ->check(CLI::Range(1, 1024));
-    solveApp
-        ->add_option("--direction-level", solve.directionLevel,
-                     "hrc: direction set of cluster light, 0..4 (4, 10, 34, 130, 514 directions)")
-        ->check(CLI::Range(0, 4));
+    AddHrcSettings(*solveApp, solve.hrc, "--", "hrc: ");
     solveApp
         ->add_option("--samples", solve.samples, "mc: paths per receiver (standard error ~ 1/sqrt)")
         ->check(CLI::Range(2, 1 << 26));
@@ -412,22 +411,7 @@ int main(int argc, char** argv) {
     errorApp->add_option("--hrc-epsilon", errorBench.hrcEpsilons, "HRC runs: ε of each")
         ->delimiter(',')
         ->check(CLI::Range(1e-9, 1.0));
-    errorApp
-        ->add_option("--hrc-subdivision", errorBench.hrc.maxSubdivision,
-                     "HRC runs: times a triangle may be split in four")
-        ->check(CLI::Range(0, 8));
-    errorApp
-        ->add_option("--hrc-visibility-rays", errorBench.hrc.visibilityRays,
-                     "HRC runs: rays estimating each link's visibility")
-        ->check(CLI::Range(1, 1024));
-    errorApp
-        ->add_option("--hrc-source-rays", errorBench.hrc.sourceRays,
-                     "HRC runs: rays estimating each link's visibility from a sun or sky cone")
-        ->check(CLI::Range(1, 1024));
-    errorApp
-        ->add_option("--hrc-direction-level", errorBench.hrc.directionLevel,
-                     "HRC runs: direction set of cluster light, 0..4")
-        ->check(CLI::Range(0, 4));
+    AddHrcSettings(*errorApp, errorBench.hrc, "--hrc-", "HRC runs: ");
     errorApp->add_flag("!--no-direct", errorBench.directOnly,
                        "No direct-light-only run (HRC at the finest ε)");
     bool noMonteCarlo = false, noHrc = false;
