@@ -153,6 +153,13 @@ class HrcSolver {
         Spectrum normalIrradiance{};
     };
 
+    // Light arriving on a patch: W/m² per side, and ∫ L dω and ∫ L ω dω per band.
+    struct Incoming {
+        Sided sides{};
+        Spectrum integral{};
+        Moment moment{};
+    };
+
     struct SideOptics {
         Spectrum rho[2]{}, tau[2]{};  // tau[s]: arriving on side s, leaving the other side
     };
@@ -728,20 +735,43 @@ class HrcSolver {
         }
         return deepest;
     }
+    // The sweeps need only the irradiance of each side; the radiance integral and moment
+    // (the light vector) are gathered and handed down with kDirections, once at the end.
+    template <bool kDirections>
     void Gather();
-    // Handing light down to the leaf patches. Descend visits the leaf patches under
-    // `start` with the sum of what their ancestors hold: `above` plus, for every ancestor
-    // n with holds(n), what add(n, sum) adds; sums are copied only at such nodes.
-    template <class Holds, class Add, class Leaf>
+    // Handing light down to the leaf patches. Descend visits the top patches under
+    // `start` (the first patch on each way down, or `start` itself) with the sum of what
+    // their ancestors hold: `above` plus, for every node n on the way with holds(n) (the
+    // top patch included), what add(n, sum) adds; sums are copied only at such nodes.
+    // top(t, sum) then hands the sum down t's own quadtree, whose patches share a normal.
+    template <class Holds, class Add, class Top>
     void Descend(std::uint32_t start, const std::vector<double>& above, Holds holds, Add add,
-                 Leaf leaf) const;
+                 Top top) const;
     // Descend over every subtree of Share in parallel, each from the sum of what the nodes
     // above it hold (sums of `width` numbers).
-    template <class Holds, class Add, class Leaf>
-    void DescendAll(std::size_t width, Holds holds, Add add, Leaf leaf) const;
+    template <class Holds, class Add, class Top>
+    void DescendAll(std::size_t width, Holds holds, Add add, Top top) const;
+    // Visits the leaf patches under patch t with `value` plus, for every patch m strictly
+    // below t on the way with holds(m), what add(m, value) adds.
+    template <class Value, class Holds, class Add, class Leaf>
+    void DescendPatches(std::uint32_t t, const Value& value, Holds holds, Add add,
+                        Leaf leaf) const {
+        const HrcNode& node = hierarchy_[t];
+        if (node.children.empty()) return leaf(t, value);
+        for (std::uint32_t child : node.children) {
+            if (!holds(child)) {
+                DescendPatches(child, value, holds, add, leaf);
+                continue;
+            }
+            Value below = value;
+            add(child, below);
+            DescendPatches(child, below, holds, add, leaf);
+        }
+    }
     // Per leaf patch, the light of the directional sources (after each Index).
     void PushSources();
     // Per leaf patch, the source light plus what the clusters and patches above gathered.
+    template <bool kDirections>
     void PushDown();
     double UpdateRadiosity();
     void Extrapolate(double factor);
@@ -887,15 +917,15 @@ void HrcSolver<kBands>::Share() {
 }
 
 template <int kBands>
-template <class Holds, class Add, class Leaf>
-void HrcSolver<kBands>::DescendAll(std::size_t width, Holds holds, Add add, Leaf leaf) const {
+template <class Holds, class Add, class Top>
+void HrcSolver<kBands>::DescendAll(std::size_t width, Holds holds, Add add, Top top) const {
     tbb::parallel_for(std::size_t{0}, subtrees_.size(), [&](std::size_t t) {
         const std::uint32_t start = preOrder_[subtrees_[t].first];
         std::vector<double> above(width, 0.0);
         for (std::uint32_t m = hierarchy_[start].parent; m != kNoNode; m = hierarchy_[m].parent) {
             if (holds(m)) add(m, above);
         }
-        Descend(start, above, holds, add, leaf);
+        Descend(start, above, holds, add, top);
     });
 }
 
@@ -952,6 +982,7 @@ void HrcSolver<kBands>::PullNode(std::uint32_t n) {
 }
 
 template <int kBands>
+template <bool kDirections>
 void HrcSolver<kBands>::Gather() {
     tbb::parallel_for(std::size_t{0}, receivers_.size(), [&](std::size_t i) {
         const std::uint32_t r = receivers_[i];
@@ -960,8 +991,7 @@ void HrcSolver<kBands>::Gather() {
         Spectrum& integral = gatheredIntegral_[r];
         auto& moment = gatheredMoment_[r];
         sides = Sided{};
-        integral = Spectrum{};
-        moment = {};
+        if constexpr (kDirections) integral = Spectrum{}, moment = {};
         double* bins =
             R.patch ? nullptr : &gatheredBins_[static_cast<std::size_t>(slot_[r]) * bins_ * bands_];
         if (bins) std::fill(bins, bins + bins_ * bands_, 0.0);
@@ -973,9 +1003,11 @@ void HrcSolver<kBands>::Gather() {
                 for (int k = 0; k < bands_; ++k) {
                     sides[kUpper][k] += transfer[0] * b[k];
                     sides[kLower][k] += transfer[1] * b[k];
-                    const double radiance = b[k] / kPi * transfer[2];
-                    integral[k] += radiance;
-                    moment[k] += radiance * toSender;
+                    if constexpr (kDirections) {
+                        const double radiance = b[k] / kPi * transfer[2];
+                        integral[k] += radiance;
+                        moment[k] += radiance * toSender;
+                    }
                 }
                 continue;
             }
@@ -999,8 +1031,10 @@ void HrcSolver<kBands>::Gather() {
                 for (int k = 0; k < bands_; ++k) {
                     const double normal = sent[k] * geometric;  // W/m² facing the sender
                     side[k] += normal * std::abs(cosine);
-                    integral[k] += normal;
-                    moment[k] += normal * toSender;
+                    if constexpr (kDirections) {
+                        integral[k] += normal;
+                        moment[k] += normal * toSender;
+                    }
                 }
             } else {
                 for (int j = 0; j < 3; ++j) {
@@ -1015,9 +1049,9 @@ void HrcSolver<kBands>::Gather() {
 }
 
 template <int kBands>
-template <class Holds, class Add, class Leaf>
+template <class Holds, class Add, class Top>
 void HrcSolver<kBands>::Descend(std::uint32_t start, const std::vector<double>& above, Holds holds,
-                                Add add, Leaf leaf) const {
+                                Add add, Top top) const {
     // Depth-first; sums[k] is written only by a node of depth k that holds something, and
     // read by its descendants, so a sibling's subtree never overwrites a sum still in use.
     struct Entry {
@@ -1037,8 +1071,8 @@ void HrcSolver<kBands>::Descend(std::uint32_t start, const std::vector<double>& 
             sum = entry.depth;
         }
         const HrcNode& node = hierarchy_[entry.node];
-        if (node.children.empty()) {
-            if (node.patch) leaf(entry.node, sums[sum]);
+        if (node.patch) {
+            top(entry.node, sums[sum]);
             continue;
         }
         for (std::uint32_t child : node.children) stack.push_back({child, entry.depth + 1, sum});
@@ -1070,30 +1104,45 @@ void HrcSolver<kBands>::PushSources() {
             }
         }
     };
-    DescendAll(sources_.size(), holds, add, leaf);
+    const auto top = [&](std::uint32_t t, const std::vector<double>& visibility) {
+        DescendPatches(t, visibility, holds, add, leaf);
+    };
+    DescendAll(sources_.size(), holds, add, top);
 }
 
 template <int kBands>
+template <bool kDirections>
 void HrcSolver<kBands>::PushDown() {
     const auto holds = [&](std::uint32_t n) { return !hierarchy_[n].patch && !links_[n].empty(); };
     const auto add = [&](std::uint32_t n, std::vector<double>& bins) {
         const double* in = &gatheredBins_[static_cast<std::size_t>(slot_[n]) * bins_ * bands_];
         for (int i = 0; i < bins_ * bands_; ++i) bins[i] += in[i];
     };
-    const auto leaf = [&](std::uint32_t n, const std::vector<double>& bins) {
-        const HrcNode& node = hierarchy_[n];
-        Sided e = sourceSides_[n];
-        Spectrum integral = sourceIntegral_[n];
-        Moment moment = sourceMoment_[n];
-        // What the patch and the patches it was split from gathered.
-        for (std::uint32_t m = n; m != kNoNode && hierarchy_[m].patch; m = hierarchy_[m].parent) {
-            for (int k = 0; k < bands_; ++k) {
-                e[kUpper][k] += gatheredSides_[m][kUpper][k];
-                e[kLower][k] += gatheredSides_[m][kLower][k];
-                integral[k] += gatheredIntegral_[m][k];
-                moment[k] += gatheredMoment_[m][k];
+    const auto patchHolds = [&](std::uint32_t n) { return !links_[n].empty(); };
+    const auto addGathered = [&](std::uint32_t n, Incoming& in) {
+        for (int k = 0; k < bands_; ++k) {
+            in.sides[kUpper][k] += gatheredSides_[n][kUpper][k];
+            in.sides[kLower][k] += gatheredSides_[n][kLower][k];
+            if constexpr (kDirections) {
+                in.integral[k] += gatheredIntegral_[n][k];
+                in.moment[k] += gatheredMoment_[n][k];
             }
         }
+    };
+    const auto leaf = [&](std::uint32_t n, const Incoming& in) {
+        for (int k = 0; k < bands_; ++k) {
+            irradiance_[n][kUpper][k] = in.sides[kUpper][k] + sourceSides_[n][kUpper][k];
+            irradiance_[n][kLower][k] = in.sides[kLower][k] + sourceSides_[n][kLower][k];
+            if constexpr (kDirections) {
+                integral_[n][k] = in.integral[k] + sourceIntegral_[n][k];
+                moment_[n][k] = in.moment[k] + sourceMoment_[n][k];
+            }
+        }
+    };
+    const auto top = [&](std::uint32_t t, const std::vector<double>& bins) {
+        // The clusters' light on t's normal, once for the patches t was split into.
+        const HrcNode& node = hierarchy_[t];
+        Incoming in;
         for (int d = 0; d < bins_; ++d) {
             const glm::dvec3& omega = directions_.Direction(d);
             const double cosine = glm::dot(node.normal, omega);
@@ -1101,16 +1150,19 @@ void HrcSolver<kBands>::PushDown() {
             if (Inner(node.triangle, side)) continue;
             for (int k = 0; k < bands_; ++k) {
                 const double normal = bins[d * bands_ + k];
-                e[side][k] += normal * std::abs(cosine);
-                integral[k] += normal;
-                moment[k] += normal * omega;
+                in.sides[side][k] += normal * std::abs(cosine);
+                if constexpr (kDirections) {
+                    in.integral[k] += normal;
+                    in.moment[k] += normal * omega;
+                }
             }
         }
-        irradiance_[n] = e;
-        integral_[n] = integral;
-        moment_[n] = moment;
+        // What t and the patches it was split from gathered.
+        for (std::uint32_t m = t; m != kNoNode && hierarchy_[m].patch; m = hierarchy_[m].parent)
+            addGathered(m, in);
+        DescendPatches(t, in, patchHolds, addGathered, leaf);
     };
-    DescendAll(bins_ * bands_, holds, add, leaf);
+    DescendAll(bins_ * bands_, holds, add, top);
 }
 
 template <int kBands>
@@ -1186,7 +1238,7 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
     // direct light only, lamps are the only senders and their links the only ones needed.
     Index();
     if (!options_.directOnly) {
-        PushDown();
+        PushDown<false>();
         UpdateRadiosity();
     }
     PullUp();
@@ -1218,8 +1270,13 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
         convergence = Convergence{};
         int sweep = 0;
         for (; iteration < iterations; ++iteration, ++sweep) {
-            Gather();
-            PushDown();
+            if (options_.directOnly) {
+                Gather<true>();
+                PushDown<true>();
+            } else {
+                Gather<false>();
+                PushDown<false>();
+            }
             if (iteration == 0) direct_ = irradiance_;
             residual = UpdateRadiosity();
             if (const double factor = convergence.Step(residual); factor > 0.0) {
@@ -1241,6 +1298,11 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
         spdlog::debug("hrc: pass {}: {} sweeps {:.3f} s, links judged again {:.3f} s", pass,
                       sweep + 1, sweepSeconds, clock.Lap());
         ++iteration;
+    }
+    if (!options_.directOnly) {
+        // The light vectors, from the light of the solution.
+        Gather<true>();
+        PushDown<true>();
     }
     solution.stats.iterations = std::min(iteration + 1, iterations);
     solution.stats.residual = convergence.Remaining(residual);
