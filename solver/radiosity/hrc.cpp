@@ -105,6 +105,12 @@ struct NodeLink {
     // sender v Ω / π, times its radiosity (bounded however near).
     std::array<float, 3> transfer{};
     Bins receiverBins, senderBins;  // not exact: R's bin of the light, S's bin that sends it
+    // For judging the link again with new light (Rerefine) without its geometry: the W it
+    // may carry per unit of its sender's light (the radiosity of S's side facing R, or S's
+    // intensity towards R, all bands), or −1 when all S sends may reach R; W per unit of
+    // difference between S's two sides' radiosity (R across S's plane); and the error per
+    // W carried (geometric error plus visibility spread).
+    float reach = 0.0f, sideReach = 0.0f, doubt = 0.0f;
 };
 
 struct SourceLink {
@@ -501,13 +507,15 @@ class HrcSolver {
         double geometric = 0.0;  // cluster link: see NodeLink; exact link: unused
         SidedFormFactor form;    // exact link: at R's centre
         double power = 0.0;      // W the link may carry, unoccluded
+        double reach = -1.0;     // power per unit of the sender's light (see NodeLink)
         double geometricError = 0.0;
         int senderSide = kUpper;
         glm::dvec3 toSender{0, 0, 1};
         bool near = false;  // exact link: R's centre does not speak for all of R
         // Exact link: W that parts of R across S's plane take from S's other side, which
-        // the link (one side, the centre's) gets wrong.
-        double sideError = 0.0;
+        // the link (one side, the centre's) gets wrong, and that per unit of difference
+        // between S's sides.
+        double sideError = 0.0, sideReach = 0.0;
     };
 
     // The error a link would carry with visibility v (W).
@@ -560,7 +568,8 @@ class HrcSolver {
             // One direction stands for the whole patch and R for all its points.
             e.geometricError =
                 std::min(1.0, std::pow((R.radius + S.radius) / std::max(d, 1e-300), 2.0));
-            e.power = radiosity * e.geometric * ExposedArea(r, e.toSender, e.geometricError);
+            e.reach = e.geometric * ExposedArea(r, e.toSender, e.geometricError);
+            e.power = radiosity * e.reach;
         } else {
             // 1/d² between centroids, times the mean of 1/|x − y|² over the two nodes' spread
             // of area to second order, 1 + (σ_R² + σ_S²) / (3 d²): without it the transfer
@@ -574,8 +583,8 @@ class HrcSolver {
             // there, all the sender's power may land on the receiver.
             e.geometricError =
                 std::min(1.0, std::pow(R.radius + S.radius, 2.0) / std::max(d * d, 1e-300));
-            e.power = Power(s, -e.toSender) * ExposedArea(r, e.toSender, e.geometricError) /
-                      std::max(d * d, 1e-300);
+            e.reach = ExposedArea(r, e.toSender, e.geometricError) / std::max(d * d, 1e-300);
+            e.power = Power(s, -e.toSender) * e.reach;
         }
         e.power = std::min(e.power, emitted_[s]);
         // Overlapping bounds: the direction between centroids says nothing (two leaves face
@@ -583,6 +592,7 @@ class HrcSolver {
         // power may reach the receiver.
         if (glm::length(S.centroid - R.centroid) < R.radius + S.radius) {
             e.power = emitted_[s];
+            e.reach = -1.0;
             e.geometricError = 1.0;
         }
         return e;
@@ -617,7 +627,8 @@ class HrcSolver {
         // the distance; otherwise parts of R may see S fully (F up to 1 on each side).
         e.near = R.radius > 0.5 * d;
         const double radiosity = SideRadiosity(s, e.senderSide);
-        e.power = radiosity * (e.near ? 1.0 : e.form.upper + e.form.lower) * R.areaM2;
+        e.reach = (e.near ? 1.0 : e.form.upper + e.form.lower) * R.areaM2;
+        e.power = radiosity * e.reach;
         if (Across(R, S)) {
             // Part of R lies across S's plane and sees S's other side: judged at R's corners
             // (drawn in a little) — a wall beside a lamp, rising above it, is lit below the
@@ -626,9 +637,10 @@ class HrcSolver {
                 const glm::dvec3 p = corner + 1e-3 * (x - corner);
                 const SidedFormFactor f = PointToTriangle(p, R.normal, S.a, S.b, S.c);
                 const int side = glm::dot(S.normal, p - S.a) >= 0.0 ? kUpper : kLower;
-                e.sideError = std::max(e.sideError, std::abs(SideRadiosity(s, side) - radiosity) *
-                                                        (f.upper + f.lower) * R.areaM2);
+                if (side != e.senderSide)
+                    e.sideReach = std::max(e.sideReach, (f.upper + f.lower) * R.areaM2);
             }
+            e.sideError = e.sideReach * std::abs(SideRadiosity(s, 1 - e.senderSide) - radiosity);
         }
         e.geometricError = std::pow(R.radius / d, 2.0);
         return e;
@@ -664,6 +676,10 @@ class HrcSolver {
         link.visibility = static_cast<float>(v);
         link.senderSide = static_cast<std::uint8_t>(e.senderSide);
         link.toSender = e.toSender;
+        link.reach = static_cast<float>(e.reach);
+        link.sideReach = static_cast<float>(e.sideReach);
+        link.doubt =
+            static_cast<float>(e.geometricError + VisibilitySpread(v, options_.visibilityRays));
         if (exact) {
             link.transfer = {static_cast<float>(e.form.upper * v),
                              static_cast<float>(e.form.lower * v),
@@ -674,6 +690,31 @@ class HrcSolver {
             link.senderBins = Locate(directions_, -e.toSender);
         }
         return verdict;
+    }
+
+    // The error a link carries with its sender's light of now (Error, from what the link
+    // kept of its estimate).
+    double LinkError(const NodeLink& link) const {
+        const std::uint32_t s = link.sender;
+        double power = emitted_[s];
+        if (link.reach >= 0.0f) {
+            double light = 0.0;  // the sender's radiosity or intensity towards R
+            if (link.senderPatch) {
+                light = SideRadiosity(s, link.senderSide);
+            } else {
+                const double* in = &intensity_[static_cast<std::size_t>(slot_[s]) * bins_ * bands_];
+                for (int j = 0; j < 3; ++j) {
+                    const double* bin = in + link.senderBins.index[j] * bands_;
+                    const double weight = link.senderBins.weight[j];
+                    for (int k = 0; k < bands_; ++k) light += weight * bin[k];
+                }
+            }
+            power = static_cast<double>(link.reach) * light;
+            if (!link.exact) power = std::min(power, emitted_[s]);
+        }
+        const double across = std::abs(SideRadiosity(s, kLower) - SideRadiosity(s, kUpper));
+        return power * static_cast<double>(link.doubt) +
+               static_cast<double>(link.sideReach) * across;
     }
 
     // Refinement judges a link by the light its sender sends when it is made: a sender lit
@@ -688,12 +729,9 @@ class HrcSolver {
         std::vector<std::uint32_t> failing(count, 0);
         tbb::parallel_for(std::size_t{0}, count, [&](std::size_t r) {
             auto& links = links_[r];
-            const auto kept =
-                std::stable_partition(links.begin(), links.end(), [&](const NodeLink& link) {
-                    const Estimate e =
-                        link.exact ? EstimateExact(r, link.sender) : EstimatePair(r, link.sender);
-                    return Error(e, link.visibility) <= threshold;
-                });
+            const auto kept = std::stable_partition(
+                links.begin(), links.end(),
+                [&](const NodeLink& link) { return LinkError(link) <= threshold; });
             failing[r] = static_cast<std::uint32_t>(links.end() - kept);
         });
         std::vector<Task> stack;
