@@ -380,6 +380,18 @@ class HrcSolver {
             direct_.resize(hierarchy_.Size(), Sided{});
             for (std::uint32_t child : hierarchy_[n].children) direct_[child] = direct_[n];
         }
+        if (n < sourceSides_.size()) {
+            // After PushSources: the parts have no source links of their own and n's
+            // normal, so they take n's source light.
+            sourceSides_.resize(hierarchy_.Size(), Sided{});
+            sourceIntegral_.resize(hierarchy_.Size(), Spectrum{});
+            sourceMoment_.resize(hierarchy_.Size(), Moment{});
+            for (std::uint32_t child : hierarchy_[n].children) {
+                sourceSides_[child] = sourceSides_[n];
+                sourceIntegral_[child] = sourceIntegral_[n];
+                sourceMoment_[child] = sourceMoment_[n];
+            }
+        }
     }
 
     void Grow() {
@@ -806,7 +818,8 @@ class HrcSolver {
             DescendPatches(child, below, holds, add, leaf);
         }
     }
-    // Per leaf patch, the light of the directional sources (after each Index).
+    // Per leaf patch, the light of the directional sources, once their links are made;
+    // patches split later take their parent's (SplitNode).
     void PushSources();
     // Per leaf patch, the source light plus what the clusters and patches above gathered.
     template <bool kDirections>
@@ -919,7 +932,6 @@ void HrcSolver<kBands>::Index() {
     for (std::uint32_t n = 0; n < size; ++n) {
         if (!links_[n].empty()) receivers_.push_back(n);
     }
-    PushSources();
 }
 
 template <int kBands>
@@ -1275,6 +1287,7 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
     // Direct light first, so that links are refined on what senders will send; with
     // direct light only, lamps are the only senders and their links the only ones needed.
     Index();
+    PushSources();
     if (!options_.directOnly) {
         PushDown<false>();
         UpdateRadiosity();
