@@ -97,17 +97,14 @@ double CapIntegralOfAbsZ(const glm::dvec3& axis, double solidAngle) {
     return sum * solidAngle / (kRings * kSectors);
 }
 
+// Integrated once per discretisation, when first asked for.
 const CellIntegration& CellsOf(SkyDiscretization discretization) {
-    static std::once_flag once;
-    static std::array<CellIntegration, 5> cache;
-    std::call_once(once, [] {
-        for (auto d : {SkyDiscretization::kTurtle46, SkyDiscretization::kTetra34,
-                       SkyDiscretization::kTetra130, SkyDiscretization::kTetra514}) {
-            cache[static_cast<int>(d)] = Integrate(d);
-        }
-    });
     LEAFLUX_CHECK(discretization != SkyDiscretization::kContinuous);
-    return cache[static_cast<int>(discretization)];
+    static std::array<std::once_flag, 5> once;
+    static std::array<CellIntegration, 5> cache;
+    const int index = static_cast<int>(discretization);
+    std::call_once(once[index], [&] { cache[index] = Integrate(discretization); });
+    return cache[index];
 }
 }  // namespace
 
