@@ -16,6 +16,8 @@ bool Finite(const glm::dvec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
+// For checks made once; the checks made per node, vertex or triangle build their field and
+// message only when they fail (a scene has hundreds of thousands).
 void Require(bool condition, ErrorCode code, const std::string& field, const std::string& message,
              std::optional<NodeId> node = std::nullopt) {
     if (!condition) throw InputError(code, field, message, node);
@@ -42,31 +44,38 @@ void RequirePerBand(const Scene& scene, const std::vector<double>& values,
 // largest angle's complement is below 1e-9 (a sliver Embree would lose in float).
 void ValidateMesh(const Mesh* mesh, const glm::dmat4& worldFromLocal, const std::string& field,
                   std::optional<NodeId> node) {
-    Require(mesh != nullptr, ErrorCode::kInvalidArgument, field, "has no mesh", node);
-    Require(!mesh->triangles.empty(), ErrorCode::kDegenerate, field + ".triangles",
-            "mesh has no triangle", node);
+    if (mesh == nullptr) throw InputError(ErrorCode::kInvalidArgument, field, "has no mesh", node);
+    if (mesh->triangles.empty()) {
+        throw InputError(ErrorCode::kDegenerate, field + ".triangles", "mesh has no triangle",
+                         node);
+    }
     for (std::size_t i = 0; i < mesh->positions.size(); ++i) {
-        Require(Finite(mesh->positions[i]), ErrorCode::kInvalidArgument,
-                field + ".positions[" + std::to_string(i) + "]", "is not finite", node);
+        if (!Finite(mesh->positions[i])) {
+            throw InputError(ErrorCode::kInvalidArgument,
+                             field + ".positions[" + std::to_string(i) + "]", "is not finite",
+                             node);
+        }
     }
     const auto vertexCount = static_cast<unsigned>(mesh->positions.size());
     for (std::size_t t = 0; t < mesh->triangles.size(); ++t) {
         const glm::uvec3& tri = mesh->triangles[t];
-        const std::string at = field + ".triangles[" + std::to_string(t) + "]";
-        Require(tri.x < vertexCount && tri.y < vertexCount && tri.z < vertexCount,
-                ErrorCode::kInvalidArgument, at,
-                "refers to a vertex beyond the " + std::to_string(vertexCount) + " positions",
-                node);
+        const auto fail = [&](ErrorCode code, const std::string& message) {
+            throw InputError(code, field + ".triangles[" + std::to_string(t) + "]", message, node);
+        };
+        if (tri.x >= vertexCount || tri.y >= vertexCount || tri.z >= vertexCount) {
+            fail(ErrorCode::kInvalidArgument,
+                 "refers to a vertex beyond the " + std::to_string(vertexCount) + " positions");
+        }
         const glm::dvec3 a = glm::dvec3(worldFromLocal * glm::dvec4(mesh->positions[tri.x], 1.0));
         const glm::dvec3 b = glm::dvec3(worldFromLocal * glm::dvec4(mesh->positions[tri.y], 1.0));
         const glm::dvec3 c = glm::dvec3(worldFromLocal * glm::dvec4(mesh->positions[tri.z], 1.0));
-        Require(Finite(a) && Finite(b) && Finite(c), ErrorCode::kInvalidArgument, at,
-                "has non-finite world coordinates", node);
+        if (!Finite(a) || !Finite(b) || !Finite(c))
+            fail(ErrorCode::kInvalidArgument, "has non-finite world coordinates");
         const double twiceArea = glm::length(glm::cross(b - a, c - a));
         const double longest =
             std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
-        Require(twiceArea > 1e-9 * longest * longest && twiceArea > 1e-18, ErrorCode::kDegenerate,
-                at, "has zero area (collapsed or repeated vertices)", node);
+        if (!(twiceArea > 1e-9 * longest * longest && twiceArea > 1e-18))
+            fail(ErrorCode::kDegenerate, "has zero area (collapsed or repeated vertices)");
     }
 }
 
@@ -97,33 +106,42 @@ void ValidateOptics(const Scene& scene) {
 
 void RequireOptics(const Scene& scene, const std::string& id, const std::string& field,
                    std::optional<NodeId> node) {
-    Require(scene.OpticsIndex(id) >= 0, ErrorCode::kNotFound, field,
-            "names unknown optics '" + id + "'", node);
+    if (scene.OpticsIndex(id) < 0)
+        throw InputError(ErrorCode::kNotFound, field, "names unknown optics '" + id + "'", node);
 }
 
 void ValidateTopology(const Scene& scene, std::set<std::string>& names) {
     std::unordered_map<NodeId, const Node*> byId;
+    byId.reserve(scene.nodes.size());
     for (const Node& node : scene.nodes) {
-        Require(node.id != 0, ErrorCode::kInvalidArgument, "nodes.id", "0 is not a valid id");
-        Require(byId.emplace(node.id, &node).second, ErrorCode::kAlreadyExists, "nodes.id",
-                "the id is used by two nodes", node.id);
+        if (node.id == 0)
+            throw InputError(ErrorCode::kInvalidArgument, "nodes.id", "0 is not a valid id");
+        if (!byId.emplace(node.id, &node).second) {
+            throw InputError(ErrorCode::kAlreadyExists, "nodes.id", "the id is used by two nodes",
+                             node.id);
+        }
     }
     for (const Node& node : scene.nodes) {
-        Require(node.parent == kNoParent || byId.count(node.parent), ErrorCode::kNotFound, "parent",
-                "names unknown node " + std::to_string(node.parent), node.id);
+        if (node.parent != kNoParent && !byId.count(node.parent)) {
+            throw InputError(ErrorCode::kNotFound, "parent",
+                             "names unknown node " + std::to_string(node.parent), node.id);
+        }
         for (int c = 0; c < 4; ++c) {
             for (int r = 0; r < 4; ++r) {
-                Require(std::isfinite(node.parentFromLocal[c][r]), ErrorCode::kInvalidArgument,
-                        "frame", "is not finite", node.id);
+                if (!std::isfinite(node.parentFromLocal[c][r]))
+                    throw InputError(ErrorCode::kInvalidArgument, "frame", "is not finite",
+                                     node.id);
             }
         }
-        Require(std::abs(glm::determinant(glm::dmat3(node.parentFromLocal))) > 1e-30,
-                ErrorCode::kDegenerate, "frame", "is singular", node.id);
-        Require(std::isfinite(node.age), ErrorCode::kInvalidArgument, "age", "is not finite",
-                node.id);
+        if (!(std::abs(glm::determinant(glm::dmat3(node.parentFromLocal))) > 1e-30))
+            throw InputError(ErrorCode::kDegenerate, "frame", "is singular", node.id);
+        if (!std::isfinite(node.age))
+            throw InputError(ErrorCode::kInvalidArgument, "age", "is not finite", node.id);
         for (const auto& [key, value] : node.attributes) {
-            Require(std::isfinite(value), ErrorCode::kInvalidArgument, "attributes[" + key + "]",
-                    "is not finite", node.id);
+            if (!std::isfinite(value)) {
+                throw InputError(ErrorCode::kInvalidArgument, "attributes[" + key + "]",
+                                 "is not finite", node.id);
+            }
         }
     }
     // Cycles: walk up from each node; a walk longer than the node count loops.
@@ -133,8 +151,10 @@ void ValidateTopology(const Scene& scene, std::set<std::string>& names) {
         NodeId at = node.id;
         while (at != kNoParent && !rooted.count(at)) {
             path.push_back(at);
-            Require(path.size() <= scene.nodes.size(), ErrorCode::kCycle, "parent",
-                    "the parent links of this node loop", node.id);
+            if (path.size() > scene.nodes.size()) {
+                throw InputError(ErrorCode::kCycle, "parent", "the parent links of this node loop",
+                                 node.id);
+            }
             at = byId.at(at)->parent;
         }
         rooted.insert(path.begin(), path.end());
@@ -144,8 +164,11 @@ void ValidateTopology(const Scene& scene, std::set<std::string>& names) {
         if (!node.organ) continue;
         RequireOptics(scene, node.organ->opticsId, "organ.optics", node.id);
         ValidateMesh(node.organ->mesh.get(), worldFromLocal.at(node.id), "organ.mesh", node.id);
-        Require(names.insert(scene.NodeName(node)).second, ErrorCode::kAlreadyExists, "name",
-                "organ name '" + scene.NodeName(node) + "' is used twice", node.id);
+        std::string name = scene.NodeName(node);
+        if (!names.insert(name).second) {
+            throw InputError(ErrorCode::kAlreadyExists, "name",
+                             "organ name '" + name + "' is used twice", node.id);
+        }
     }
 }
 
@@ -267,10 +290,12 @@ Scene WithBands(const Scene& scene, const std::vector<int>& bands) {
     return subset;
 }
 
-std::map<NodeId, glm::dmat4> WorldFromLocal(const Scene& scene) {
+std::unordered_map<NodeId, glm::dmat4> WorldFromLocal(const Scene& scene) {
     std::unordered_map<NodeId, const Node*> byId;
+    byId.reserve(scene.nodes.size());
     for (const Node& node : scene.nodes) byId.emplace(node.id, &node);
-    std::map<NodeId, glm::dmat4> result;
+    std::unordered_map<NodeId, glm::dmat4> result;
+    result.reserve(scene.nodes.size());
     for (const Node& node : scene.nodes) {
         // Collect the unresolved ancestors, then compose downwards.
         std::vector<const Node*> chain;

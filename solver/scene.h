@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "solver/sources.h"
@@ -102,7 +103,7 @@ struct Scene {
 Scene WithBands(const Scene& scene, const std::vector<int>& bands);
 
 // worldFromLocal of every node, by id. Requires a validated scene (no cycles).
-std::map<NodeId, glm::dmat4> WorldFromLocal(const Scene& scene);
+std::unordered_map<NodeId, glm::dmat4> WorldFromLocal(const Scene& scene);
 
 // Area (m²) of a triangle mesh after applying worldFromLocal.
 double MeshArea(const Mesh& mesh, const glm::dmat4& worldFromLocal);

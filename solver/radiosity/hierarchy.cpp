@@ -20,6 +20,8 @@ void TriangleMoments(HrcNode& node) {
 }  // namespace
 
 Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat) : flat_(flat) {
+    // A patch per triangle and fewer clusters than patches, before any subdivision.
+    nodes_.reserve(2 * flat.triangles.size());
     // Receivers first: one patch per triangle, grouped when an organ has several.
     std::vector<std::uint32_t> receiverNode(flat.receivers.size(), kNoNode);
     for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
