@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <set>
 #include <unordered_map>
 
@@ -32,6 +33,33 @@ v1::ErrorCode ToProto(ErrorCode code) {
             return v1::ERROR_CODE_UNSUPPORTED;
     }
     return v1::ERROR_CODE_INTERNAL;
+}
+
+using Clock = std::chrono::steady_clock;
+
+double Milliseconds(Clock::time_point since) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
+}
+
+// The request's kind and the session it concerns, for the log.
+std::string Describe(const v1::Request& request) {
+    switch (request.body_case()) {
+        case v1::Request::kOpenSession:
+            return "open_session";
+        case v1::Request::kCycle:
+            return "cycle " + std::to_string(request.cycle().number()) + " of session " +
+                   request.cycle().session();
+        case v1::Request::kResync:
+            return "resync of session " + request.resync().session();
+        case v1::Request::kStatus:
+            return "status";
+        case v1::Request::kCloseSession:
+            return "close_session " + request.close_session().session();
+        case v1::Request::kShutdown:
+            return "shutdown";
+        default:
+            return "request without a known body";
+    }
 }
 
 // A session-level unknown id: its own code, so a client knows to resync.
@@ -125,7 +153,10 @@ v1::CycleResult Session::Run(const v1::Cycle& cycle) {
         ++cycles_;
         return result;
     }
+    const Clock::time_point start = Clock::now();
     Scene next = Next(cycle);
+    spdlog::debug("cycle {}: delta applied and the scene validated in {:.1f} ms", cycle.number(),
+                  Milliseconds(start));
     v1::CycleResult result = Solve(next, cycle.outputs());
     scene_ = std::move(next);
     Count();
@@ -205,8 +236,13 @@ v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outp
     const Scene subset = allBands ? Scene{} : WithBands(scene, wanted);
     const Scene& solved = allBands ? scene : subset;
     if (!allBands) wanted = order;
+    Clock::time_point start = Clock::now();
     const PreparedScene prepared(solved);
+    spdlog::debug("scene flattened and its ray engine built in {:.1f} ms", Milliseconds(start));
+    start = Clock::now();
     const Solution solution = leaflux::Solve(prepared, settings_);
+    spdlog::debug("solved in {:.1f} ms (hierarchy built, then {:.1f} ms of solver)",
+                  Milliseconds(start), 1e3 * solution.stats.wallSeconds);
     v1::CycleResult result;
     if (outputs.leaves()) {
         for (std::size_t r = 0; r < prepared.Flat().receivers.size(); ++r) {
@@ -238,6 +274,7 @@ v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outp
     stats->set_elements(solution.stats.elements);
     stats->set_iterations(solution.stats.iterations);
     stats->set_residual(solution.stats.residual);
+    stats->set_threads(solution.stats.threads);
     for (int b : wanted) {
         v1::EnergyBalance* balance = stats->add_balance();
         balance->set_band(solved.bands[b].name);
@@ -278,6 +315,7 @@ std::string Daemon::KeyOf(const v1::Request& request) {
 
 v1::Reply Daemon::Handle(const v1::Request& request) {
     ++requests_;
+    const Clock::time_point start = Clock::now();
     v1::Reply reply;
     try {  // the one place a request's failure is caught
         if (request.version() > v1::PROTOCOL_VERSION_CURRENT) {
@@ -318,7 +356,31 @@ v1::Reply Daemon::Handle(const v1::Request& request) {
     }
     reply.set_version(v1::PROTOCOL_VERSION_CURRENT);
     reply.set_request_id(request.request_id());
+    // Status is polled: its timing only at debug level.
+    const auto level = reply.has_error()                             ? spdlog::level::warn
+                       : request.body_case() == v1::Request::kStatus ? spdlog::level::debug
+                                                                     : spdlog::level::info;
+    if (spdlog::should_log(level)) {
+        const std::string outcome =
+            reply.has_error()
+                ? fmt::format(
+                      "{} ({}{})", v1::ErrorCode_Name(reply.error().code()), reply.error().field(),
+                      reply.error().node() ? ", node " + std::to_string(reply.error().node()) : "")
+                : "done";
+        spdlog::log(level, "request {}: {}: {} in {:.2f} ms", request.request_id(),
+                    Describe(request), outcome, Milliseconds(start));
+    }
     return reply;
+}
+
+SolverSettings Daemon::Settings(const v1::SolverSettings& in) const {
+    SolverSettings settings = SettingsFromProto(in);
+    if (limits_.solverThreads > 0) {
+        int& threads = settings.hrc.threads;
+        threads = threads == 0 ? limits_.solverThreads : std::min(threads, limits_.solverThreads);
+        settings.monteCarlo.threads = threads;
+    }
+    return settings;
 }
 
 std::shared_ptr<Session> Daemon::Find(const std::string& id) {
@@ -335,7 +397,7 @@ v1::Reply Daemon::Open(const v1::OpenSession& request) {
                          "the daemon reads no files: send the geometry");
     }
     Scene scene = FromProto(request.scene(), "");
-    SolverSettings settings = SettingsFromProto(request.settings());
+    SolverSettings settings = Settings(request.settings());
     auto session = std::make_shared<Session>(std::move(scene), MeshesFromProto(request.scene()),
                                              std::move(settings));
     std::string id;
@@ -372,7 +434,7 @@ v1::Reply Daemon::Resynchronise(const v1::Resync& request) {
                          "the daemon reads no files: send the geometry");
     }
     Scene scene = FromProto(request.scene(), "");
-    SolverSettings settings = SettingsFromProto(request.settings());
+    SolverSettings settings = Settings(request.settings());
     auto session = std::make_shared<Session>(std::move(scene), MeshesFromProto(request.scene()),
                                              std::move(settings));
     {

@@ -56,6 +56,7 @@ class Session {
 
 struct DaemonLimits {
     std::size_t maxSessions = 64;
+    int solverThreads = 0;  // cores one solve may use; 0: all
 };
 
 class Daemon {
@@ -78,6 +79,8 @@ class Daemon {
     v1::Reply Status(const v1::StatusRequest& request);
     v1::Reply Close(const v1::CloseSession& request);
     std::shared_ptr<Session> Find(const std::string& id);
+    // A session's solver settings, its threads within the daemon's limit.
+    SolverSettings Settings(const v1::SolverSettings& in) const;
 
     DaemonLimits limits_;
     std::mutex mutex_;  // guards the map and the id counter, never held while solving

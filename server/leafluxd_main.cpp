@@ -1,5 +1,7 @@
 // leafluxd: the lighting daemon. Growth models connect over ZeroMQ and speak leaflux.v1
 // (proto/leaflux.proto): OpenSession, then a Cycle per growth step, and CloseSession.
+#include <spdlog/sinks/basic_file_sink.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -17,7 +19,7 @@ void OnSignal(int) { stopRequested = true; }
 int main(int argc, char** argv) {
     using namespace leaflux;
     CLI::App app{"leafluxd: the leaflux lighting daemon (ZeroMQ + protobuf, leaflux.v1)"};
-    std::string bind = "tcp://127.0.0.1:5555", level = "info";
+    std::string bind = "tcp://127.0.0.1:5555", level = "info", logFile;
     DaemonLimits limits;
     TransportLimits transport;
     std::size_t maxMegabytes = 256;
@@ -26,6 +28,11 @@ int main(int argc, char** argv) {
     app.add_option("--bind", bind, "ZeroMQ endpoint to serve (loopback by default)");
     app.add_option("--log-level", level, "trace, debug, info, warn, error")
         ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+    app.add_option("--log-file", logFile,
+                   "Also append the log to this file (every request with its timing at info)");
+    app.add_option("--solver-threads", limits.solverThreads,
+                   "Cores one solve may use (0: all); a session asking fewer gets fewer")
+        ->check(CLI::Range(0, 1024));
     app.add_option("--max-sessions", limits.maxSessions, "Sessions served at once")
         ->check(CLI::Range(1, 100000));
     app.add_option("--workers", workers,
@@ -38,6 +45,19 @@ int main(int argc, char** argv) {
     app.add_option("--max-message-mb", maxMegabytes, "Largest request accepted (MiB)")
         ->check(CLI::Range(1, 4096));
     CLI11_PARSE(app, argc, argv);
+    if (!logFile.empty()) {
+        try {
+            auto logger = std::make_shared<spdlog::logger>(
+                "leafluxd", spdlog::sinks_init_list{
+                                std::make_shared<spdlog::sinks::stderr_color_sink_mt>(),
+                                std::make_shared<spdlog::sinks::basic_file_sink_mt>(logFile)});
+            spdlog::set_default_logger(logger);
+            spdlog::flush_every(std::chrono::seconds(1));
+        } catch (const spdlog::spdlog_ex& e) {
+            spdlog::error("--log-file {}: {}", logFile, e.what());
+            return 2;
+        }
+    }
     spdlog::set_level(spdlog::level::from_str(level));
     transport.maxBytes = maxMegabytes << 20;
     std::string curveSecretKey;

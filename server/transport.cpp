@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cerrno>
 #include <cstdint>
 #include <deque>
 #include <fstream>
@@ -69,7 +70,12 @@ void RouterServer::Serve(const Dispatch& dispatch, const std::function<std::stri
     zmq::pollitem_t items[] = {{socket_.handle(), 0, ZMQ_POLLIN, 0},
                                {pull.handle(), 0, ZMQ_POLLIN, 0}};
     while (!stop) {
-        zmq::poll(items, 2, std::chrono::milliseconds(100));
+        try {
+            zmq::poll(items, 2, std::chrono::milliseconds(100));
+        } catch (const zmq::error_t& e) {
+            if (e.num() == EINTR) continue;  // a signal (SIGINT, SIGTERM): `stop` says what next
+            throw;
+        }
         if (items[1].revents & ZMQ_POLLIN) {
             zmq::message_t ignored;
             while (pull.recv(ignored, zmq::recv_flags::dontwait)) {

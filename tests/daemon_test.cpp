@@ -9,6 +9,7 @@
 #include <functional>
 #include <limits>
 #include <thread>
+#include <tuple>
 
 #include "tests/daemon_fixture.h"
 
@@ -655,6 +656,20 @@ TEST(DaemonBands, OnlyTheRequestedBandsAreSolvedAndSent) {
     EXPECT_NEAR(nirOnly.cycle().organs(1).bands(0).irradiance_upper_wm2(), full, 0.05 * full);
     one.mutable_cycle()->mutable_outputs()->add_bands("NIR");
     EXPECT_EQ(daemon.Handle(one).error().code(), v1::ERROR_CODE_ALREADY_EXISTS);
+}
+
+// --solver-threads caps the cores of every solve; a session asking fewer gets fewer.
+TEST(DaemonThreads, SolvesUseAtMostTheDaemonsSolverThreads) {
+    for (const auto& [limit, asked, used] : {std::tuple{1, 0, 1}, {1, 2, 1}, {2, 1, 1}}) {
+        Daemon daemon(DaemonLimits{.solverThreads = limit});
+        v1::Request open = OpenRequest();
+        open.mutable_open_session()->mutable_settings()->set_threads(asked);
+        const std::string session = daemon.Handle(open).opened().session();
+        const v1::Reply reply = daemon.Handle(CycleRequest(session, 1));
+        ASSERT_TRUE(reply.has_cycle()) << reply.DebugString();
+        EXPECT_EQ(reply.cycle().statistics().threads(), used)
+            << "limit " << limit << ", asked " << asked;
+    }
 }
 
 // With a CurveZMQ secret key the daemon answers clients that know its public key, and

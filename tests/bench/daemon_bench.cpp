@@ -4,6 +4,7 @@
 // and 10,000 leaves (HRC, ε = 1e-4), one tenth of the plant added per cycle.
 // Run: build/release/tests/leaflux_bench_daemon [out.csv]
 #include <spdlog/cfg/env.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <chrono>
@@ -87,7 +88,10 @@ struct Row {
 
 int main(int argc, char** argv) {
     using namespace leaflux;
-    spdlog::cfg::load_env_levels();  // SPDLOG_LEVEL=debug shows the solver's phases
+    // Every request is logged at info level: SPDLOG_LEVEL=info shows them, debug the phases
+    // of each cycle and of the solver.
+    spdlog::set_level(spdlog::level::warn);
+    spdlog::cfg::load_env_levels();
     std::vector<Row> rows;
     Loopback daemon;
     {
