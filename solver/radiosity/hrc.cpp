@@ -310,8 +310,14 @@ class HrcSolver {
     // factor's kernel |cos θx| |cos θy| / |x − y|² (the receiving cosine as push-down hands
     // the light to patches). Unweighted, far pairs count as much as near ones and are more
     // often blocked: the 500-leaf canopy at ρ = τ = 0.45 lost 2.3 % of its NIR that way.
-    // Counts the rays it traces in `rays`.
-    double Visibility(std::uint32_t r, std::uint32_t s, std::int64_t& rays) const {
+    // Between two patches, `unoccluded` is the analytic form factor: the rays then estimate
+    // only the part that is blocked, (A_S / π) × the mean of kernel × blocked, taken off the
+    // analytic value. That estimate is unbiased and a link whose rays all pass keeps the
+    // exact form factor; the weighted ratio is biased low with 8 rays, and the stability
+    // suite's dense canopies lost 0.35–0.47 % of their light that way. Counts the rays it
+    // traces in `rays`.
+    double Visibility(std::uint32_t r, std::uint32_t s, std::int64_t& rays,
+                      double unoccluded = 0.0) const {
         Random random(StreamSeed(0x5EED, r, s));
         const int count = options_.visibilityRays;
         double visible = 0.0, total = 0.0;
@@ -329,6 +335,10 @@ class HrcSolver {
             total += weight;
             if (!rays_.Occluded({p.position, p.triangle}, d / distance, distance * (1.0 - 1e-4)))
                 visible += weight;
+        }
+        if (unoccluded > 0.0) {
+            const double blocked = hierarchy_[s].areaM2 / kPi * (total - visible) / count;
+            return std::clamp(1.0 - blocked / unoccluded, 0.0, 1.0);
         }
         return total > 0.0 ? visible / total : 0.0;
     }
@@ -542,11 +552,9 @@ class HrcSolver {
         for (int b = 0; b < bands_; ++b) total += radiosity_[s][side][b];
         return total;
     }
-    // Whether node R reaches across the plane of patch S: then its centroid's side is not
-    // the side all of R sees (a wall beside a lamp, partly above it). A patch in S's plane
-    // sees nothing of S and is not across it.
-    static bool Across(const HrcNode& R, const HrcNode& S) {
-        if (!R.patch) return std::abs(glm::dot(S.normal, R.centroid - S.a)) < R.radius;
+    // How far patch R's corners lie below and above the plane of patch S (≤ 0 and ≥ 0),
+    // rounding below 1e-9 of R's size counted as in the plane.
+    static std::pair<double, double> Heights(const HrcNode& R, const HrcNode& S) {
         const double tolerance = 1e-9 * R.radius;
         double below = 0.0, above = 0.0;
         for (const glm::dvec3& p : {R.a, R.b, R.c}) {
@@ -554,7 +562,21 @@ class HrcSolver {
             below = std::min(below, height);
             above = std::max(above, height);
         }
-        return below < -tolerance && above > tolerance;
+        return {below < -tolerance ? below : 0.0, above > tolerance ? above : 0.0};
+    }
+    // Whether node R reaches across the plane of patch S: then its centroid's side is not
+    // the side all of R sees (a wall beside a lamp, partly above it). A patch in S's plane
+    // sees nothing of S and is not across it.
+    static bool Across(const HrcNode& R, const HrcNode& S) {
+        if (!R.patch) return std::abs(glm::dot(S.normal, R.centroid - S.a)) < R.radius;
+        const auto [below, above] = Heights(R, S);
+        return below < 0.0 && above > 0.0;
+    }
+    // Whether patch R lies in the plane of patch S (two triangles of one flat leaf), where
+    // no light passes between them.
+    static bool InPlane(const HrcNode& R, const HrcNode& S) {
+        const auto [below, above] = Heights(R, S);
+        return below == 0.0 && above == 0.0;
     }
 
     Estimate EstimatePair(std::uint32_t r, std::uint32_t s) const {
@@ -663,6 +685,7 @@ class HrcSolver {
     // Rerefine once it has lit up.
     Verdict JudgePair(std::uint32_t r, std::uint32_t s) const {
         const bool exact = hierarchy_[r].patch && hierarchy_[s].patch;
+        if (exact && InPlane(hierarchy_[r], hierarchy_[s])) return {};
         const Estimate e = exact ? EstimateExact(r, s) : EstimatePair(r, s);
         if (exact && !e.near && e.form.upper + e.form.lower <= 0.0) return {};
         // Geometry alone may call for a split: then no visibility rays are spent on it.
@@ -672,7 +695,7 @@ class HrcSolver {
                 return {split, {}, 0};
         }
         Verdict verdict;
-        const double v = Visibility(r, s, verdict.rays);
+        const double v = Visibility(r, s, verdict.rays, exact ? e.form.upper + e.form.lower : 0.0);
         if (Error(e, v) > threshold) {
             if (const auto split = SplitChoice(r, s); split != Verdict::kNone) {
                 verdict.kind = split;
