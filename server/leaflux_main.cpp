@@ -101,7 +101,7 @@ struct GenerateCommand {
     double spacing = 6.0, rowSpacing = 0.0, rowAzimuth = 0.0, sunElevation = 50.0,
            sunAzimuth = 160.0;
     double sunPar = 400.0, sunNir = 350.0, skyPar = 100.0, skyNir = 60.0;
-    bool noSky = false;
+    bool noSky = false, noGround = false;
     CanopyParameters canopy;
     bool randomCanopy = false;
     bool greenhouse = false;
@@ -146,7 +146,7 @@ int RunGenerate(const GenerateCommand& command) {
         greenhouse.lampExitanceWm2 = {command.lampPar, command.lampNir};
         AddGreenhouse(scene, greenhouse);
     } else {
-        AddPlantation(scene, plantation, "ground");
+        AddPlantation(scene, plantation, command.noGround ? "" : "ground");
     }
     const double h = glm::radians(command.sunElevation), a = glm::radians(command.sunAzimuth);
     if (!command.greenhouse) {
@@ -313,6 +313,8 @@ int main(int argc, char** argv) {
     generateApp->add_option("--sun-azimuth", generate.sunAzimuth,
                             "Sun azimuth from north, clockwise (deg)");
     generateApp->add_flag("--no-sky", generate.noSky, "Sun only, no diffuse sky");
+    generateApp->add_flag("--no-ground", generate.noGround,
+                          "Trees without the ground under them (as a growth model sends a plant)");
     generateApp->add_flag("--random-canopy", generate.randomCanopy,
                           "A random canopy of square leaves (spherical angles) instead of trees");
     generateApp->add_flag(

@@ -1,7 +1,8 @@
 // leafluxd over loopback TCP: the protocol's own cost (Status round trips, a cycle with an
 // empty delta, answered with the last cycle's light — with the organs' results or none —
-// or solved again when it asks other outputs) and the latency of cycles of a plant growing to 1,000
-// and 10,000 leaves (HRC, ε = 1e-4), one tenth of the plant added per cycle.
+// or solved again when it asks other outputs) and the latency of cycles of a plant growing to
+// 1,000 leaves (HRC, ε = 1e-4 and 3e-4) and 10,000 leaves (ε = 1e-4), one tenth of the plant
+// added per cycle.
 // Run: build/release/tests/leaflux_bench_daemon [out.csv]
 #include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <fstream>
 #include <thread>
+#include <utility>
 
 #include "server/daemon.h"
 #include "server/executor.h"
@@ -79,7 +81,9 @@ v1::Scene TreeScene(int leaves, std::vector<v1::Node>& nodes) {
 
 struct Row {
     std::string what;
-    int leaves, cycle, organs;
+    int leaves;
+    double epsilon;
+    int cycle, organs;
     double roundTripMs, solveMs;
 };
 
@@ -100,13 +104,13 @@ int main(int argc, char** argv) {
         constexpr int kCalls = 2000;
         const auto start = Clock::now();
         for (int i = 0; i < kCalls; ++i) daemon.Call(status);
-        rows.push_back({"status", 0, 0, 0, 1e3 * Seconds(start) / kCalls, 0.0});
+        rows.push_back({"status", 0, 0.0, 0, 0, 1e3 * Seconds(start) / kCalls, 0.0});
     }
-    for (int leaves : {1000, 10000}) {
+    for (const auto& [leaves, epsilon] : {std::pair{1000, 1e-4}, {1000, 3e-4}, {10000, 1e-4}}) {
         std::vector<v1::Node> nodes;
         v1::Request open;
         *open.mutable_open_session()->mutable_scene() = TreeScene(leaves, nodes);
-        open.mutable_open_session()->mutable_settings()->set_epsilon(1e-4);
+        open.mutable_open_session()->mutable_settings()->set_epsilon(epsilon);
         const std::string session = daemon.Call(open).opened().session();
         constexpr int kCycles = 10;
         std::size_t next = 0;
@@ -120,7 +124,7 @@ int main(int argc, char** argv) {
             for (; next < until; ++next) *cycle->mutable_delta()->add_added() = nodes[next];
             const auto start = Clock::now();
             const v1::Reply reply = daemon.Call(request);
-            rows.push_back({"growing_tree", leaves, c, reply.cycle().organs_size(),
+            rows.push_back({"growing_tree", leaves, epsilon, c, reply.cycle().organs_size(),
                             1e3 * Seconds(start), 1e3 * reply.cycle().statistics().wall_seconds()});
         }
         // The same plant again with nothing changed. Asking what the last cycle asked, its
@@ -143,7 +147,7 @@ int main(int argc, char** argv) {
                 times.push_back(1e3 * Seconds(start));
             }
             std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
-            rows.push_back({what, leaves, number, reply.cycle().organs_size(),
+            rows.push_back({what, leaves, epsilon, number, reply.cycle().organs_size(),
                             times[times.size() / 2],
                             1e3 * reply.cycle().statistics().wall_seconds()});
         };
@@ -153,14 +157,15 @@ int main(int argc, char** argv) {
     }
     const char* path = argc > 1 ? argv[1] : "daemon_bench.csv";
     std::ofstream csv(path);
-    csv << "what,leaves,cycle,organs,round_trip_ms,solve_ms,overhead_ms\n";
-    std::printf("%-14s %7s %6s %7s %14s %10s %12s\n", "what", "leaves", "cycle", "organs",
-                "round_trip_ms", "solve_ms", "overhead_ms");
+    csv << "what,leaves,epsilon,cycle,organs,round_trip_ms,solve_ms,overhead_ms\n";
+    std::printf("%-14s %7s %8s %6s %7s %14s %10s %12s\n", "what", "leaves", "epsilon", "cycle",
+                "organs", "round_trip_ms", "solve_ms", "overhead_ms");
     for (const Row& r : rows) {
-        csv << r.what << ',' << r.leaves << ',' << r.cycle << ',' << r.organs << ','
-            << r.roundTripMs << ',' << r.solveMs << ',' << r.roundTripMs - r.solveMs << '\n';
-        std::printf("%-14s %7d %6d %7d %14.3f %10.3f %12.3f\n", r.what.c_str(), r.leaves, r.cycle,
-                    r.organs, r.roundTripMs, r.solveMs, r.roundTripMs - r.solveMs);
+        csv << r.what << ',' << r.leaves << ',' << r.epsilon << ',' << r.cycle << ',' << r.organs
+            << ',' << r.roundTripMs << ',' << r.solveMs << ',' << r.roundTripMs - r.solveMs << '\n';
+        std::printf("%-14s %7d %8.0e %6d %7d %14.3f %10.3f %12.3f\n", r.what.c_str(), r.leaves,
+                    r.epsilon, r.cycle, r.organs, r.roundTripMs, r.solveMs,
+                    r.roundTripMs - r.solveMs);
     }
     std::printf("wrote %s\n", path);
     return 0;
