@@ -64,8 +64,8 @@ Solution SolveAndRecord(const PreparedScene& prepared, const SolverSettings& set
 // 1e-5 test). HRC's links each carry an error up to ε of the source power and its escape
 // is counted by rays, apart from the links: the two do not cancel exactly. At ε = 1e-5 it
 // closes to 0.5 % on open, mildly scattering scenes and in the dense canopies (measured
-// 0.3–0.5 %), and is measured at 0.8 % for leaves 1 µm apart, 1.1 % for a lamp 1 mm
-// below a leaf and 0.8–1.5 % in the closed boxes at ε = 1e-6: `hrcBound` is set by each
+// under 0.05 %), and is measured at 0.8 % for leaves 1 µm apart, 1.0 % for a lamp 1 mm
+// below a leaf and 0.7–1.1 % in the closed boxes at ε = 1e-6: `hrcBound` is set by each
 // test, never above 5 %.
 void ExpectBalanced(const Solution& solution, SolverKind kind, double hrcBound = 5e-3) {
     for (const EnergyBalance& e : solution.balance) {
