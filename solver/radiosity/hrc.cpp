@@ -329,7 +329,8 @@ class HrcSolver {
             const double distance = glm::length(d);
             if (distance <= 0.0) continue;
             const double weight = ReceivingWeight(p.triangle, p.normal, d / distance) *
-                                  std::abs(glm::dot(q.normal, d)) / std::pow(distance, 3.0);
+                                  std::abs(glm::dot(q.normal, d)) /
+                                  (distance * distance * distance);
             if (weight <= 0.0) continue;
             ++rays;
             total += weight;
@@ -372,7 +373,7 @@ class HrcSolver {
     }
 
     double MinArea(const HrcNode& patch) const {
-        return flat_.triangles[patch.triangle].areaM2 / std::pow(4.0, options_.maxSubdivision) *
+        return std::ldexp(flat_.triangles[patch.triangle].areaM2, -2 * options_.maxSubdivision) *
                0.999;
     }
 
