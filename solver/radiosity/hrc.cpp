@@ -10,6 +10,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <queue>
 #include <unordered_map>
 
@@ -75,19 +76,27 @@ class Convergence {
     int steady_ = 0;
 };
 
-// Where a direction falls among the direction set's bins: three bins and their weights.
+// Where a direction falls among the direction set's bins: three bins and their weights,
+// the first two in 65535ths and the third what they leave, so that the weights sum to 1
+// exactly in ten bytes.
 struct Bins {
+    static constexpr double kUnit = 65535.0;
     std::array<std::uint16_t, 3> index{};
-    std::array<float, 3> weight{};
+    std::array<std::uint16_t, 2> weight{};
+
+    double Weight(int j) const {
+        return j < 2 ? weight[j] / kUnit : 1.0 - (weight[0] + weight[1]) / kUnit;
+    }
 };
 
 Bins Locate(const DirectionSet& set, const glm::dvec3& direction) {
     const auto located = set.Locate(direction);
     Bins bins;
-    for (int j = 0; j < 3; ++j) {
-        bins.index[j] = static_cast<std::uint16_t>(located.vertex[j]);
-        bins.weight[j] = static_cast<float>(located.weight[j]);
-    }
+    for (int j = 0; j < 3; ++j) bins.index[j] = static_cast<std::uint16_t>(located.vertex[j]);
+    const auto first = static_cast<long>(std::lround(located.weight[0] * Bins::kUnit));
+    const auto second = static_cast<long>(std::lround(located.weight[1] * Bins::kUnit));
+    bins.weight[0] = static_cast<std::uint16_t>(std::clamp(first, 0L, 65535L));
+    bins.weight[1] = static_cast<std::uint16_t>(std::clamp(second, 0L, 65535L - bins.weight[0]));
     return bins;
 }
 
@@ -98,8 +107,7 @@ struct NodeLink {
     bool exact = false;                // patch ← patch by the analytic form factor
     bool senderPatch = false;          // a patch sends its radiosity, a cluster its intensity
     std::uint8_t senderSide = kUpper;  // a patch sender: its side facing R
-    float visibility = 0.0f;
-    glm::vec3 toSender{0.0f};  // unit, from R's centre
+    glm::vec3 toSender{0.0f};          // unit, from R's centre
     // Exact: v F on R's upper and lower sides and v Ω (the solid angle of S at R's centre).
     // Else transfer[0]: for a cluster sender v / d², times its intensity; for a patch
     // sender v Ω / π, times its radiosity (bounded however near).
@@ -133,7 +141,8 @@ struct Task {
 struct Verdict {
     enum Kind : std::uint8_t { kNone, kLink, kSplitReceiver, kSplitSender };
     Kind kind = kNone;
-    NodeLink link;  // kLink of a pair; a source's visibility is link.visibility
+    NodeLink link;            // kLink of a pair
+    float visibility = 0.0f;  // kLink of a source
     std::int64_t rays = 0;
 };
 
@@ -468,7 +477,7 @@ class HrcSolver {
                 return;
             case Verdict::kLink:
                 if (task.kind == Task::kSource) {
-                    sourceLinks_[r].push_back({s, verdict.link.visibility});
+                    sourceLinks_[r].push_back({s, verdict.visibility});
                 } else {
                     links_[r].push_back(verdict.link);
                 }
@@ -500,7 +509,7 @@ class HrcSolver {
             verdict.kind = Verdict::kSplitReceiver;
         } else if (v > 0.0) {
             verdict.kind = Verdict::kLink;
-            verdict.link.visibility = static_cast<float>(v);
+            verdict.visibility = static_cast<float>(v);
         }
         return verdict;
     }
@@ -709,7 +718,6 @@ class HrcSolver {
         link.sender = s;
         link.exact = exact;
         link.senderPatch = hierarchy_[s].patch;
-        link.visibility = static_cast<float>(v);
         link.senderSide = static_cast<std::uint8_t>(e.senderSide);
         link.toSender = e.toSender;
         link.reach = static_cast<float>(e.reach);
@@ -728,23 +736,29 @@ class HrcSolver {
         return verdict;
     }
 
+    // What a link's sender sends towards R, per band: the radiosity of a patch's side, the
+    // intensity of a cluster.
+    Spectrum Sent(const NodeLink& link) const {
+        if (link.senderPatch) return radiosity_[link.sender][link.senderSide];
+        Spectrum sent{};
+        const double* in =
+            &intensity_[static_cast<std::size_t>(slot_[link.sender]) * bins_ * bands_];
+        for (int j = 0; j < 3; ++j) {
+            const double* bin = in + link.senderBins.index[j] * bands_;
+            const double weight = link.senderBins.Weight(j);
+            for (int k = 0; k < bands_; ++k) sent[k] += weight * bin[k];
+        }
+        return sent;
+    }
+
     // The error a link carries with its sender's light of now (Error, from what the link
     // kept of its estimate).
     double LinkError(const NodeLink& link) const {
         const std::uint32_t s = link.sender;
         double power = emitted_[s];
         if (link.reach >= 0.0f) {
-            double light = 0.0;  // the sender's radiosity or intensity towards R
-            if (link.senderPatch) {
-                light = SideRadiosity(s, link.senderSide);
-            } else {
-                const double* in = &intensity_[static_cast<std::size_t>(slot_[s]) * bins_ * bands_];
-                for (int j = 0; j < 3; ++j) {
-                    const double* bin = in + link.senderBins.index[j] * bands_;
-                    const double weight = link.senderBins.weight[j];
-                    for (int k = 0; k < bands_; ++k) light += weight * bin[k];
-                }
-            }
+            const Spectrum sent = Sent(link);
+            const double light = std::accumulate(sent.begin(), sent.begin() + bands_, 0.0);
             power = static_cast<double>(link.reach) * light;
             if (!link.exact) power = std::min(power, emitted_[s]);
         }
@@ -1085,19 +1099,7 @@ void HrcSolver<kBands>::Gather() {
                 }
                 continue;
             }
-            // What S sends towards R: the radiosity of a patch, the intensity of a cluster.
-            Spectrum sent{};
-            if (link.senderPatch) {
-                sent = radiosity_[link.sender][link.senderSide];
-            } else {
-                const double* in =
-                    &intensity_[static_cast<std::size_t>(slot_[link.sender]) * bins_ * bands_];
-                for (int j = 0; j < 3; ++j) {
-                    const double* bin = in + link.senderBins.index[j] * bands_;
-                    const double weight = link.senderBins.weight[j];
-                    for (int k = 0; k < bands_; ++k) sent[k] += weight * bin[k];
-                }
-            }
+            const Spectrum sent = Sent(link);
             const double geometric = transfer[0];
             if (R.patch) {
                 const double cosine = glm::dot(R.normal, toSender);
@@ -1113,8 +1115,7 @@ void HrcSolver<kBands>::Gather() {
             } else {
                 for (int j = 0; j < 3; ++j) {
                     double* bin = bins + link.receiverBins.index[j] * bands_;
-                    const double weight =
-                        static_cast<double>(link.receiverBins.weight[j]) * geometric;
+                    const double weight = link.receiverBins.Weight(j) * geometric;
                     for (int k = 0; k < bands_; ++k) bin[k] += weight * sent[k];
                 }
             }
