@@ -1401,16 +1401,36 @@ void HrcSolver<kBands>::Outputs(Solution& solution) {
     for (std::uint32_t n : preOrder_) {
         if (hierarchy_[n].patch && hierarchy_[n].children.empty()) leaves.push_back(n);
     }
-    std::vector<std::array<double, 2>> escape(leaves.size());
+    // The power each side sends (all bands but its own emission): rays go where it is.
+    std::vector<std::array<double, 2>> sent(leaves.size());
+    double total = 0.0;
+    for (std::size_t i = 0; i < leaves.size(); ++i) {
+        const std::uint32_t n = leaves[i];
+        for (int s : {kUpper, kLower}) {
+            double radiosity = 0.0;
+            for (int b = 0; b < bands_; ++b)
+                radiosity += radiosity_[n][s][b] - (s == kUpper ? emission_[n][b] : 0.0);
+            total += sent[i][s] = hierarchy_[n].areaM2 * std::max(radiosity, 0.0);
+        }
+    }
+    const double mean = total / std::max<std::size_t>(1, 2 * leaves.size());
+    // Per side: the escaping fraction and the variance of that estimate (none where every
+    // ray agrees: a closed box's walls, whose every ray hits).
+    std::vector<std::array<double, 2>> escape(leaves.size()), doubt(leaves.size());
     std::vector<std::int64_t> rays(leaves.size(), 0);
     tbb::parallel_for(std::size_t{0}, leaves.size(), [&](std::size_t i) {
         SetFlushToZero();
         const HrcNode& node = hierarchy_[leaves[i]];
         Random random(StreamSeed(0xE5C, leaves[i]));
-        // A few stratified rays a side: the estimate is unbiased and only its sum over
-        // the scene matters (the escaped power of the energy balance).
-        const int count = std::max(2, options_.visibilityRays / 2);
+        // Stratified rays a side, in proportion to the power it sends (2 for the mean side,
+        // 2 to 64): the estimate is unbiased, only its sum over the scene matters (the
+        // escaped power of the energy balance), and that sum is dominated by bright sides
+        // (a leaf patch over a lamp 1 mm below it).
         for (int s : {kUpper, kLower}) {
+            const int count =
+                mean > 0.0
+                    ? static_cast<int>(std::clamp(std::lround(2.0 * sent[i][s] / mean), 2L, 64L))
+                    : 2;
             int out = 0;
             for (int k = 0; k < count; ++k) {
                 const Hierarchy::Point p =
@@ -1421,11 +1441,13 @@ void HrcSolver<kBands>::Outputs(Solution& solution) {
                 out += rays_.Trace({p.position, p.triangle}, omega).fate != RayFate::kHit;
             }
             escape[i][s] = static_cast<double>(out) / count;
+            doubt[i][s] = escape[i][s] * (1.0 - escape[i][s]) / (count - 1.0);
             rays[i] += count;
         }
     });
     for (std::int64_t r : rays) rayCount_ += r;
     std::vector<double> area(flat_.receivers.size(), 0.0);
+    Spectrum variance{};
     for (std::size_t i = 0; i < leaves.size(); ++i) {
         const std::uint32_t n = leaves[i];
         const HrcNode& node = hierarchy_[n];
@@ -1446,11 +1468,14 @@ void HrcSolver<kBands>::Outputs(Solution& solution) {
             EnergyBalance& balance = solution.balance[k];
             balance.incidentW += a * (direct_[n][kUpper][k] + direct_[n][kLower][k]);
             balance.absorbedW += absorbed;
-            balance.escapedW +=
-                a * ((radiosity_[n][kUpper][k] - emission_[n][k]) * escape[i][kUpper] +
-                     radiosity_[n][kLower][k] * escape[i][kLower]);
+            const double upper = a * (radiosity_[n][kUpper][k] - emission_[n][k]);
+            const double lower = a * radiosity_[n][kLower][k];
+            balance.escapedW += upper * escape[i][kUpper] + lower * escape[i][kLower];
+            variance[k] += upper * upper * doubt[i][kUpper] + lower * lower * doubt[i][kLower];
         }
     }
+    // The links' own error is not in it: this is the escape estimate's noise alone.
+    for (int k = 0; k < bands_; ++k) solution.balance[k].stderrW = std::sqrt(variance[k]);
     for (std::size_t r = 0; r < flat_.receivers.size(); ++r) {
         for (BandLight& light : solution.light[r]) {
             if (area[r] <= 0.0) continue;
