@@ -39,8 +39,8 @@ SCENES = {
                ["--reference-samples", "8192", "--hrc-epsilon", "1e-3,1e-4,1e-5"]),
     "canopy500": (["--random-canopy", "--canopy-leaves", "500", "--lai", "3", "--canopy-width", "2",
                    "--no-sky"],
-                  "random canopy, 500 leaves, LAI 3, NIR ρ = τ = 0.45, sun only (the HRC issue's "
-                  "target: 1 % L2 in NIR in 0.3 s)",
+                  "random canopy, 500 leaves, LAI 3, NIR ρ = τ = 0.45, sun only (HRC's goal: "
+                  "1 % L2 in NIR in 0.3 s)",
                   ["--reference-samples", "16384", "--hrc-epsilon", "1e-3,1e-4,1e-5"]),
     "bac1": (None, "Caribu's seedling tray bac1.can (2,270 triangles) under the 46-direction "
                    "overcast sky of Turtle46soc.light",
