@@ -233,7 +233,7 @@ TEST(HrcTree, ErrorAgainstMonteCarloFallsWithEpsilon) {
         RecordProperty("mean_relative_error_at_" + std::to_string(epsilon), std::to_string(error));
         previous = error;
     }
-    // The bound for lit leaves (3 %); this tree measures 1.2 % at ε = 1e-5, with the
+    // The bound HRC must meet for lit leaves (3 %); this tree measures 1.2 % at ε = 1e-5, with the
     // reference's own noise (about 1 % a leaf at 2,048 paths) inside that.
     EXPECT_LT(previous, 0.03);
 }
