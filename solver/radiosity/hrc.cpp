@@ -862,6 +862,11 @@ class HrcSolver {
     // Per leaf patch, the source light plus what the clusters and patches above gathered.
     template <bool kDirections>
     void PushDown();
+    template <bool kDirections>
+    void Collect() {
+        Gather<kDirections>();
+        PushDown<kDirections>();
+    }
     double UpdateRadiosity();
     void Extrapolate(double factor);
     void Outputs(Solution& solution);
@@ -1347,11 +1352,9 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
         int sweep = 0;
         for (; iteration < iterations; ++iteration, ++sweep) {
             if (options_.directOnly) {
-                Gather<true>();
-                PushDown<true>();
+                Collect<true>();  // the one sweep: its light is the answer
             } else {
-                Gather<false>();
-                PushDown<false>();
+                Collect<false>();
             }
             if (iteration == 0) direct_ = irradiance_;
             residual = UpdateRadiosity();
@@ -1375,11 +1378,7 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
                       sweep + 1, sweepSeconds, clock.Lap());
         ++iteration;
     }
-    if (!options_.directOnly) {
-        // The light vectors, from the light of the solution.
-        Gather<true>();
-        PushDown<true>();
-    }
+    if (!options_.directOnly) Collect<true>();  // the light vectors, from the solution's light
     solution.stats.iterations = std::min(iteration + 1, iterations);
     solution.stats.residual = convergence.Remaining(residual);
     Outputs(solution);
