@@ -502,10 +502,15 @@ class HrcSolver {
         for (int b = 0; b < bands_; ++b) power += source.normalIrradiance[b];
         const double unoccluded = power * ProjectedArea(r, source.toward);
         if (unoccluded <= 0.0) return {};
+        // The spread is least when every ray agrees: beyond ε even then, no ray can save
+        // the link, and none is traced.
+        const double threshold = options_.epsilon * totalPower_;
+        if (unoccluded * VisibilitySpread(1.0, options_.sourceRays) > threshold && CanSplit(r))
+            return {Verdict::kSplitReceiver, {}, 0.0f, 0};
         Verdict verdict;
         const double v = SourceVisibility(r, s, verdict.rays);
         const double error = unoccluded * VisibilitySpread(v, options_.sourceRays);
-        if (error > options_.epsilon * totalPower_ && CanSplit(r)) {
+        if (error > threshold && CanSplit(r)) {
             verdict.kind = Verdict::kSplitReceiver;
         } else if (v > 0.0) {
             verdict.kind = Verdict::kLink;
@@ -698,9 +703,11 @@ class HrcSolver {
         if (exact && InPlane(hierarchy_[r], hierarchy_[s])) return {};
         const Estimate e = exact ? EstimateExact(r, s) : EstimatePair(r, s);
         if (exact && !e.near && e.form.upper + e.form.lower <= 0.0) return {};
-        // Geometry alone may call for a split: then no visibility rays are spent on it.
+        // Geometry and the least spread any rays could show may call for a split: then no
+        // visibility rays are spent on it.
         const double threshold = options_.epsilon * totalPower_;
-        if (e.power * e.geometricError + e.sideError > threshold) {
+        const double leastSpread = VisibilitySpread(1.0, options_.visibilityRays);
+        if (e.power * (e.geometricError + leastSpread) + e.sideError > threshold) {
             if (const auto split = SplitChoice(r, s); split != Verdict::kNone)
                 return {split, {}, 0};
         }
