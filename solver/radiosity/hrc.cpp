@@ -709,7 +709,7 @@ class HrcSolver {
         const double leastSpread = VisibilitySpread(1.0, options_.visibilityRays);
         if (e.power * (e.geometricError + leastSpread) + e.sideError > threshold) {
             if (const auto split = SplitChoice(r, s); split != Verdict::kNone)
-                return {split, {}, 0};
+                return {split, {}, 0.0f, 0};
         }
         Verdict verdict;
         const double v = Visibility(r, s, verdict.rays, exact ? e.form.upper + e.form.lower : 0.0);
