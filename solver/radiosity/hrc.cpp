@@ -127,6 +127,8 @@ struct NodeLink {
     float reach = 0.0f, sideReach = 0.0f, geometricError = 0.0f;
 
     double Spread() const { return spread / kUnit; }
+    // A link whose rays were all blocked carries nothing; it is kept to be judged again.
+    bool Carries() const { return transfer != std::array<float, 3>{}; }
 };
 
 // The two sets of visibility rays of a link, as random streams: those that judge it and
@@ -327,6 +329,15 @@ class HrcSolver {
         return Inner(triangle, cosine > 0.0 ? kUpper : kLower) ? 0.0 : std::abs(cosine);
     }
 
+    // What a link's rays show (Visibility).
+    struct Sight {
+        double visibility = 0.0;
+        // How far the rays disagreed (VisibilitySpread of the fraction that passed): the
+        // weighted visibility can be 0 or 1 while they did not, one near ray outweighing
+        // the rest.
+        double spread = 0.0;
+    };
+
     // The unoccluded fraction of the light from s that r's points take, from stratified
     // rays between points x of r and y of s, each weighted by what it carries, the form
     // factor's kernel |cos θx| |cos θy| / |x − y|² (the receiving cosine as push-down hands
@@ -341,13 +352,6 @@ class HrcSolver {
     // rest (the stiff canopy of ρ = τ = 0.45 then gained 0.3 % of its light), and down to −1
     // a link never carries more than the unoccluded form factor, so that the sweeps still
     // converge. Counts the rays it traces in `rays`.
-    struct Sight {
-        double visibility = 0.0;
-        // How far the rays disagreed (VisibilitySpread of the fraction that passed): the
-        // weighted visibility can be 0 or 1 while they did not, one near ray outweighing
-        // the rest.
-        double spread = 0.0;
-    };
     Sight Visibility(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
                      double unoccluded = 0.0) const {
         Random random(StreamSeed(static_cast<std::uint64_t>(set), r, s));
@@ -778,6 +782,7 @@ class HrcSolver {
         return verdict;
     }
 
+    // The link's transfer from its estimate and a visibility v.
     void SetTransfer(NodeLink& link, const Estimate& e, double v) const {
         if (link.exact) {
             link.transfer = {static_cast<float>(e.form.upper * v),
@@ -1168,6 +1173,7 @@ void HrcSolver<kBands>::Gather() {
             R.patch ? nullptr : &gatheredBins_[static_cast<std::size_t>(slot_[r]) * bins_ * bands_];
         if (bins) std::fill(bins, bins + bins_ * bands_, 0.0);
         for (const NodeLink& link : links_[r]) {
+            if (!link.Carries()) continue;
             const glm::dvec3 toSender(link.toSender);
             const glm::dvec3 transfer(link.transfer[0], link.transfer[1], link.transfer[2]);
             if (link.exact) {
