@@ -26,21 +26,22 @@ int CopyIndex(int i, int j) {
     return -1;
 }
 
-// The intersect context with the triangle the ray leaves from, ignored by the filter.
+// The intersect context with the periodic copy of the triangle rays leave from; the ray's
+// id holds that triangle, which the filter ignores.
 struct StartContext {
     RTCIntersectContext context;
-    std::uint32_t triangle;
     int copy;
 };
 
 void IgnoreStartTriangle(const RTCFilterFunctionNArguments* args) {
     const auto* start = reinterpret_cast<const StartContext*>(args->context);
-    if (start->triangle == kNoTriangle) return;
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
+        const unsigned triangle = RTCRayN_id(args->ray, args->N, i);
+        if (triangle == kNoTriangle) continue;
         const unsigned instance = RTCHitN_instID(args->hit, args->N, i, 0);
         const int copy = instance == RTC_INVALID_GEOMETRY_ID ? 0 : static_cast<int>(instance);
-        if (RTCHitN_primID(args->hit, args->N, i) == start->triangle && copy == start->copy) {
+        if (RTCHitN_primID(args->hit, args->N, i) == triangle && copy == start->copy) {
             args->valid[i] = 0;
         }
     }
@@ -50,11 +51,10 @@ void ThrowOnEmbreeError(void*, RTCError code, const char* message) {
     throw InternalError("embree error " + std::to_string(code) + ": " + (message ? message : ""));
 }
 
-StartContext MakeContext(const RayStart& start) {
+StartContext MakeContext(int copy) {
     StartContext context;
     rtcInitIntersectContext(&context.context);
-    context.triangle = start.triangle;
-    context.copy = start.copy;
+    context.copy = copy;
     return context;
 }
 
@@ -70,7 +70,7 @@ RTCRay MakeRay(const RayStart& start, const glm::dvec3& direction, double tFar) 
     ray.tfar = std::isinf(tFar) ? std::numeric_limits<float>::infinity() : static_cast<float>(tFar);
     ray.time = 0.0f;
     ray.mask = 0xFFFFFFFFu;
-    ray.id = 0;
+    ray.id = start.triangle;
     ray.flags = 0;
     return ray;
 }
@@ -166,7 +166,7 @@ RayScene::~RayScene() {
 }
 
 RayHit RayScene::TraceOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const {
-    StartContext context = MakeContext(start);
+    StartContext context = MakeContext(start.copy);
     RTCRayHit rayHit;
     rayHit.ray = MakeRay(start, direction, tFar);
     rayHit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -185,7 +185,7 @@ RayHit RayScene::TraceOnce(const RayStart& start, const glm::dvec3& direction, d
 }
 
 bool RayScene::OccludedOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const {
-    StartContext context = MakeContext(start);
+    StartContext context = MakeContext(start.copy);
     RTCRay ray = MakeRay(start, direction, tFar);
     rtcOccluded1(top_, &context.context, &ray);
     return ray.tfar < 0.0f;  // Embree sets tfar to -inf on occlusion
@@ -254,6 +254,25 @@ RayHit RayScene::Trace(const RayStart& start, const glm::dvec3& direction) const
     RayHit escaped;
     escaped.fate = Escape(direction);
     return escaped;
+}
+
+void RayScene::Occluded(const std::vector<RayStart>& starts, const glm::dvec3& direction,
+                        std::vector<std::uint8_t>& occluded) const {
+    occluded.resize(starts.size());
+    if (periodic_) {
+        for (std::size_t i = 0; i < starts.size(); ++i) occluded[i] = Occluded(starts[i], direction);
+        return;
+    }
+    thread_local std::vector<RTCRay> rays;
+    rays.clear();
+    for (const RayStart& start : starts) {
+        rays.push_back(MakeRay(start, direction, std::numeric_limits<double>::infinity()));
+    }
+    StartContext context = MakeContext(0);
+    context.context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcOccluded1M(top_, &context.context, rays.data(), static_cast<unsigned>(rays.size()),
+                  sizeof(RTCRay));
+    for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = rays[i].tfar < 0.0f;
 }
 
 bool RayScene::Occluded(const RayStart& start, const glm::dvec3& direction,

@@ -13,6 +13,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "solver/geometry.h"
 
@@ -73,6 +74,10 @@ class RayScene {
     // Whether anything lies along the ray within maxDistance (infinity: to the sky).
     bool Occluded(const RayStart& start, const glm::dvec3& direction,
                   double maxDistance = std::numeric_limits<double>::infinity()) const;
+    // Occluded to the sky, for rays from many starts in one direction (the rays of a sun
+    // or sky cone), traced together: occluded[i] is 1 where ray i is blocked.
+    void Occluded(const std::vector<RayStart>& starts, const glm::dvec3& direction,
+                  std::vector<std::uint8_t>& occluded) const;
 
     const FlatScene& Flat() const { return flat_; }
     bool Periodic() const { return periodic_.has_value(); }

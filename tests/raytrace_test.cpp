@@ -46,6 +46,37 @@ TEST(RayScene, LeavesItsStartTriangleEvenOneMicrometreFromTheNext) {
     EXPECT_EQ(rays.Trace({origin, 0}, {0, 0, -1}).fate, RayFate::kEscapedDown);
 }
 
+TEST(RayScene, TracesRaysOfOneDirectionTogetherAsOneByOne) {
+    // Plates 1 µm to 0.3 m apart, shifted sideways: rays leave every triangle (and points
+    // off the surfaces) towards one sun, some blocked, some not.
+    std::vector<std::shared_ptr<const Mesh>> plates;
+    for (int k = 0; k < 6; ++k) {
+        const double x = 0.3 * k, z = k == 1 ? 1e-6 : 0.3 * k;
+        plates.push_back(Quad({x, 0, z}, {x + 1, 0, z}, {x + 1, 1, z}, {x, 1, z}));
+    }
+    const FlatScene flat = Plates(plates);
+    const RayScene rays(flat, std::nullopt);
+    const glm::dvec3 sun = glm::normalize(glm::dvec3(0.4, 0.1, 1.0));
+    std::vector<RayStart> starts;
+    for (std::uint32_t t = 0; t < flat.triangles.size(); ++t) {
+        const Triangle& tri = flat.triangles[t];
+        for (const glm::dvec3& w : {glm::dvec3(1, 1, 1) / 3.0, glm::dvec3(0.8, 0.1, 0.1)}) {
+            starts.push_back({w.x * tri.a + w.y * tri.b + w.z * tri.c, t});
+        }
+        starts.push_back({(tri.a + tri.b + tri.c) / 3.0 - 0.01 * sun});
+    }
+    std::vector<std::uint8_t> together;
+    rays.Occluded(starts, sun, together);
+    ASSERT_EQ(together.size(), starts.size());
+    int blocked = 0;
+    for (std::size_t i = 0; i < starts.size(); ++i) {
+        EXPECT_EQ(together[i] != 0, rays.Occluded(starts[i], sun)) << "ray " << i;
+        blocked += together[i];
+    }
+    EXPECT_GT(blocked, 0);
+    EXPECT_LT(blocked, static_cast<int>(starts.size()));
+}
+
 TEST(RayScene, WrapsAroundAPeriodicTile) {
     // A plate overhanging the tile [0, 1]² on the +x side, at z = 1.
     const auto plate = Quad({0.8, 0.4, 1}, {1.2, 0.4, 1}, {1.2, 0.6, 1}, {0.8, 0.6, 1});

@@ -394,15 +394,24 @@ class HrcSolver {
         const glm::dvec3& toward = sources_[source].toward;
         Random random(StreamSeed(0x50C, r, source));
         const int count = options_.sourceRays;
-        double visible = 0.0, total = 0.0;
+        thread_local std::vector<RayStart> starts;
+        thread_local std::vector<double> weights;
+        thread_local std::vector<std::uint8_t> occluded;
+        starts.clear(), weights.clear();
         for (int i = 0; i < count; ++i) {
             const Hierarchy::Point p =
                 hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
             const double weight = ReceivingWeight(p.triangle, p.normal, toward);
             if (weight <= 0.0) continue;
-            ++rays;
-            total += weight;
-            if (!rays_.Occluded({p.position, p.triangle}, toward)) visible += weight;
+            starts.push_back({p.position, p.triangle});
+            weights.push_back(weight);
+        }
+        rays += static_cast<std::int64_t>(starts.size());
+        rays_.Occluded(starts, toward, occluded);
+        double visible = 0.0, total = 0.0;
+        for (std::size_t i = 0; i < starts.size(); ++i) {
+            total += weights[i];
+            if (!occluded[i]) visible += weights[i];
         }
         return total > 0.0 ? visible / total : 0.0;
     }
@@ -1409,6 +1418,7 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
     }
     PullUp();
     const double sourceSeconds = clock.Lap();
+    const std::int64_t sourceRays = rayCount_;
     const bool lamps = std::any_of(preOrder_.begin(), preOrder_.end(), [&](std::uint32_t n) {
         return std::any_of(emission_[n].begin(), emission_[n].begin() + bands_,
                            [](double e) { return e > 0.0; });
@@ -1417,6 +1427,7 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
         Refine({{Task::kSelf, hierarchy_.Root(), hierarchy_.Root()}});
     Index();
     const double refineSeconds = clock.Lap();
+    const std::int64_t refineRays = rayCount_ - sourceRays;
 
     // Jacobi from the emission: the first sweep's light is the direct light. Then the links
     // are judged again with the light of the solution and the iteration goes on from it,
@@ -1466,9 +1477,13 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
     if (!options_.directOnly) Collect<true>();  // the light vectors, from the solution's light
     solution.stats.iterations = std::min(iteration + 1, iterations);
     solution.stats.residual = convergence.Remaining(residual);
+    const std::int64_t passRays = rayCount_ - sourceRays - refineRays;
     Outputs(solution);
-    spdlog::debug("hrc: source links {:.3f} s, refinement {:.3f} s, outputs {:.3f} s",
-                  sourceSeconds, refineSeconds, clock.Lap());
+    spdlog::debug(
+        "hrc: source links {:.3f} s ({} rays), refinement {:.3f} s ({} rays, {} more in the "
+        "passes), outputs {:.3f} s ({} rays)",
+        sourceSeconds, sourceRays, refineSeconds, refineRays, passRays, clock.Lap(),
+        rayCount_ - sourceRays - refineRays - passRays);
 }
 
 template <int kBands>
