@@ -656,6 +656,10 @@ class HrcSolver {
                 std::max(glm::dot(centre - R.centroid, centre - R.centroid), 1e-300);
             const double spread = std::min(R.spread * R.spread / (3.0 * square), 1.0);
             e.geometric = SphericalTriangleSolidAngle(ra, rb, rc) / kPi * (1.0 + spread);
+            // The side of S facing R sends B A_S; the link hands B × geometric to each unit of
+            // R's area facing S: no more than S sends, however near R's centroid is.
+            const double facing = ProjectedArea(r, e.toSender);
+            if (facing > 0.0) e.geometric = std::min(e.geometric, S.areaM2 / facing);
             const double radiosity = SideRadiosity(s, e.senderSide);
             // One direction stands for the whole patch and R for all its points.
             e.geometricError =
@@ -671,6 +675,10 @@ class HrcSolver {
                 std::max(glm::dot(gap, gap), 0.25 * std::pow(R.radius + S.radius, 2.0));
             const double spread = (R.spread * R.spread + S.spread * S.spread) / (3.0 * square);
             e.geometric = std::min(1.0 + spread, 2.0) / square;
+            // S of even radiosity B sends I = B P_S(ω) / π towards R, and B A_S in all:
+            // the link hands R's area facing S no more than that.
+            const double facing = ProjectedArea(r, e.toSender) * ProjectedArea(s, -e.toSender);
+            if (facing > 0.0) e.geometric = std::min(e.geometric, 2.0 * kPi * S.areaM2 / facing);
             // The error bound does not trust the bounded transfer of overlapping clusters:
             // there, all the sender's power may land on the receiver.
             e.geometricError =
