@@ -241,8 +241,7 @@ v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outp
     spdlog::debug("scene flattened and its ray engine built in {:.1f} ms", Milliseconds(start));
     start = Clock::now();
     const Solution solution = leaflux::Solve(prepared, settings_);
-    spdlog::debug("hierarchy built and solved in {:.1f} ms, {:.1f} ms of it solving",
-                  Milliseconds(start), 1e3 * solution.stats.wallSeconds);
+    spdlog::debug("solved in {:.1f} ms", Milliseconds(start));
     v1::CycleResult result;
     if (outputs.leaves()) {
         for (std::size_t r = 0; r < prepared.Flat().receivers.size(); ++r) {

@@ -13,14 +13,12 @@ namespace leaflux {
 namespace {
 constexpr int kMaxLevel = 4;
 
-bool InsideFace(const glm::dvec3& d, const glm::dvec3& a, const glm::dvec3& b,
-                const glm::dvec3& c) {
-    // Inside the spherical triangle: on the inner side of the three great-circle planes.
-    // A small tolerance keeps directions on an edge inside both faces.
+// Inside the spherical triangle: on the inner side of its three great-circle planes. A
+// small tolerance keeps directions on an edge inside both faces.
+bool InsideFace(const glm::dvec3& d, const std::array<glm::dvec3, 3>& edges) {
     constexpr double kTolerance = -1e-12;
-    return glm::dot(glm::cross(a, b), d) >= kTolerance &&
-           glm::dot(glm::cross(b, c), d) >= kTolerance &&
-           glm::dot(glm::cross(c, a), d) >= kTolerance;
+    return glm::dot(edges[0], d) >= kTolerance && glm::dot(edges[1], d) >= kTolerance &&
+           glm::dot(edges[2], d) >= kTolerance;
 }
 }  // namespace
 
@@ -61,6 +59,13 @@ DirectionSet::DirectionSet(int level) {
         levels_.push_back(std::move(children));
     }
     faces_ = levels_.back();
+    for (const auto& faces : levels_) {
+        auto& edges = edges_.emplace_back();
+        for (const auto& [a, b, c] : faces) {
+            const glm::dvec3 &pa = directions_[a], &pb = directions_[b], &pc = directions_[c];
+            edges.push_back({glm::cross(pa, pb), glm::cross(pb, pc), glm::cross(pc, pa)});
+        }
+    }
     // Each direction gets a third of the solid angle of every face around it.
     solidAngles_.assign(directions_.size(), 0.0);
     for (const auto& [a, b, c] : faces_) {
@@ -96,8 +101,7 @@ int DirectionSet::LocateFace(const glm::dvec3& d) const {
         constexpr int count = 4;  // the tetrahedron's faces, then a face's children
         int found = -1;
         for (int f = first; f < first + count; ++f) {
-            const auto& [a, b, c] = levels_[l][f];
-            if (InsideFace(d, directions_[a], directions_[b], directions_[c])) {
+            if (InsideFace(d, edges_[l][f])) {
                 found = f;
                 break;
             }

@@ -43,6 +43,8 @@ class DirectionSet {
     // faces_ of every level, children of face f of level l at 4f..4f+3 of level l+1, so
     // that Locate descends the subdivision in O(level).
     std::vector<std::vector<std::array<int, 3>>> levels_;
+    // By level and face: the normals a × b, b × c, c × a of its three great-circle edges.
+    std::vector<std::vector<std::array<glm::dvec3, 3>>> edges_;
 };
 
 // Solid angle (sr) of the spherical triangle with unit vertices a, b, c

@@ -260,7 +260,8 @@ void RayScene::Occluded(const std::vector<RayStart>& starts, const glm::dvec3& d
                         std::vector<std::uint8_t>& occluded) const {
     occluded.resize(starts.size());
     if (periodic_) {
-        for (std::size_t i = 0; i < starts.size(); ++i) occluded[i] = Occluded(starts[i], direction);
+        for (std::size_t i = 0; i < starts.size(); ++i)
+            occluded[i] = Occluded(starts[i], direction);
         return;
     }
     thread_local std::vector<RTCRay> rays;

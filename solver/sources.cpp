@@ -35,6 +35,26 @@ int TurtleCell(const glm::dvec3& d) {
     return first - 1;
 }
 
+// ∫ |ω_z| dω over the cap of solid angle `solidAngle` around `axis`, by a midpoint rule
+// in (cos θ, φ) about the axis, uniform in solid angle (relative error below 1e-6).
+double CapIntegralOfAbsZ(const glm::dvec3& axis, double solidAngle) {
+    constexpr int kRings = 64, kSectors = 128;
+    const double cosMax = 1.0 - solidAngle / (2.0 * kPi);
+    glm::dvec3 t = std::abs(axis.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0);
+    t = glm::normalize(glm::cross(axis, t));
+    const glm::dvec3 b = glm::cross(axis, t);
+    double sum = 0.0;
+    for (int i = 0; i < kRings; ++i) {
+        const double z = 1.0 - (i + 0.5) / kRings * (1.0 - cosMax);
+        const double r = std::sqrt(1.0 - z * z);
+        for (int j = 0; j < kSectors; ++j) {
+            const double phi = 2.0 * kPi * (j + 0.5) / kSectors;
+            sum += std::abs((r * std::cos(phi) * t + r * std::sin(phi) * b + z * axis).z);
+        }
+    }
+    return sum * solidAngle / (kRings * kSectors);
+}
+
 // Cells of a discretisation, with their solid angles and centroids integrated over a
 // Fibonacci lattice of the upper hemisphere (low discrepancy: cell solid angles to ~1e-4).
 struct CellIntegration {
@@ -42,6 +62,9 @@ struct CellIntegration {
     std::vector<int> cellOfPoint;  // per lattice point
     std::vector<glm::dvec3> pointDirections;
     std::vector<SkyCell> cells;
+    // Per cell: the irradiance its cone gives a horizontal plane per unit radiance, ∫ |z|
+    // over its cap, the part below the horizon folded up as the solvers fold it.
+    std::vector<double> horizontalPerRadiance;
 };
 
 CellIntegration Integrate(SkyDiscretization discretization) {
@@ -74,27 +97,11 @@ CellIntegration Integrate(SkyDiscretization discretization) {
             {glm::normalize(sum[c]), 2.0 * kPi * count[c] / CellIntegration::kPoints});
     }
     for (int& cell : result.cellOfPoint) cell = renumber[cell];
-    return result;
-}
-
-// ∫ |ω_z| dω over the cap of solid angle `solidAngle` around `axis`, by a midpoint rule
-// in (cos θ, φ) about the axis, uniform in solid angle (relative error below 1e-6).
-double CapIntegralOfAbsZ(const glm::dvec3& axis, double solidAngle) {
-    constexpr int kRings = 64, kSectors = 128;
-    const double cosMax = 1.0 - solidAngle / (2.0 * kPi);
-    glm::dvec3 t = std::abs(axis.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0);
-    t = glm::normalize(glm::cross(axis, t));
-    const glm::dvec3 b = glm::cross(axis, t);
-    double sum = 0.0;
-    for (int i = 0; i < kRings; ++i) {
-        const double z = 1.0 - (i + 0.5) / kRings * (1.0 - cosMax);
-        const double r = std::sqrt(1.0 - z * z);
-        for (int j = 0; j < kSectors; ++j) {
-            const double phi = 2.0 * kPi * (j + 0.5) / kSectors;
-            sum += std::abs((r * std::cos(phi) * t + r * std::sin(phi) * b + z * axis).z);
-        }
+    for (const SkyCell& cell : result.cells) {
+        result.horizontalPerRadiance.push_back(
+            CapIntegralOfAbsZ(cell.direction, cell.solidAngleSr));
     }
-    return sum * solidAngle / (kRings * kSectors);
+    return result;
 }
 
 // Integrated once per discretisation, when first asked for.
@@ -189,17 +196,11 @@ std::vector<SkyCone> Sky::Cones() const {
             cone.radianceWm2Sr[b] += Radiance(b, integration.pointDirections[i]);
         }
     }
-    // Irradiance each cone gives a horizontal plane per unit radiance: ∫ |z| over its cap,
-    // the part below the horizon folded up as the solvers fold it.
-    std::vector<double> horizontalPerRadiance;
-    for (const SkyCone& cone : cones) {
-        horizontalPerRadiance.push_back(CapIntegralOfAbsZ(cone.direction, cone.solidAngleSr));
-    }
     for (int b = 0; b < bands; ++b) {
         double horizontal = 0.0;
         for (std::size_t c = 0; c < cones.size(); ++c) {
             cones[c].radianceWm2Sr[b] /= points[c];
-            horizontal += cones[c].radianceWm2Sr[b] * horizontalPerRadiance[c];
+            horizontal += cones[c].radianceWm2Sr[b] * integration.horizontalPerRadiance[c];
         }
         const double scale = horizontal > 0.0 ? horizontalIrradianceWm2[b] / horizontal : 0.0;
         for (SkyCone& cone : cones) cone.radianceWm2Sr[b] *= scale;

@@ -220,8 +220,8 @@ class HrcSolver {
         }
     }
 
-    Solution Run() {
-        const ResourceClock clock;
+    // The clock started before the hierarchy was built: its time is the solve's.
+    Solution Run(const ResourceClock& clock) {
         Solution solution;
         solution.light.assign(flat_.receivers.size(), std::vector<BandLight>(bands_));
         solution.balance.assign(bands_, EnergyBalance{});
@@ -260,35 +260,35 @@ class HrcSolver {
 
     // ---- Geometry of nodes -------------------------------------------------------------
 
-    // Σ A |n · ω| of the node's patches (both sides together).
-    double ProjectedArea(std::uint32_t n, const glm::dvec3& omega) const {
+    // Σ A |n · ω| of the node's patches (both sides together); `at`: ω located in the
+    // direction set already (a cluster's value is interpolated between its bins).
+    double ProjectedArea(std::uint32_t n, const glm::dvec3& omega,
+                         const DirectionSet::Interpolation* at = nullptr) const {
         const HrcNode& node = hierarchy_[n];
         if (node.patch) return node.areaM2 * std::abs(glm::dot(node.normal, omega));
-        const auto w = directions_.Locate(omega);
+        const auto w = at ? *at : directions_.Locate(omega);
         double area = 0.0;
         for (int k = 0; k < 3; ++k)
             area += w.weight[k] * projected_[slot_[n] * bins_ + w.vertex[k]];
         return area;
     }
 
-    // Radiant intensity (W/sr) of band b leaving node n towards ω.
-    double Intensity(std::uint32_t n, const glm::dvec3& omega, int b) const {
+    // Radiant intensity (W/sr) leaving node n towards ω, all bands together.
+    double Power(std::uint32_t n, const glm::dvec3& omega,
+                 const DirectionSet::Interpolation* at = nullptr) const {
         const HrcNode& node = hierarchy_[n];
+        double total = 0.0;
         if (node.patch) {
             const double cosine = glm::dot(node.normal, omega);
-            return node.areaM2 * std::abs(cosine) *
-                   radiosity_[n][cosine > 0.0 ? kUpper : kLower][b] / kPi;
+            for (int b = 0; b < bands_; ++b)
+                total += radiosity_[n][cosine > 0.0 ? kUpper : kLower][b];
+            return node.areaM2 * std::abs(cosine) * total / kPi;
         }
-        const auto w = directions_.Locate(omega);
-        double value = 0.0;
-        for (int k = 0; k < 3; ++k)
-            value += w.weight[k] * intensity_[(slot_[n] * bins_ + w.vertex[k]) * bands_ + b];
-        return value;
-    }
-
-    double Power(std::uint32_t n, const glm::dvec3& omega) const {
-        double total = 0.0;
-        for (int b = 0; b < bands_; ++b) total += Intensity(n, omega, b);
+        const auto w = at ? *at : directions_.Locate(omega);
+        for (int k = 0; k < 3; ++k) {
+            const double* bin = &intensity_[(slot_[n] * bins_ + w.vertex[k]) * bands_];
+            for (int b = 0; b < bands_; ++b) total += w.weight[k] * bin[b];
+        }
         return total;
     }
 
@@ -574,12 +574,11 @@ class HrcSolver {
         return Verdict::kNone;
     }
 
-    // R's area facing the light of a sender in direction ω, for the error estimate: its
-    // projected area when the sender is small and far, up to its whole area as the sender
+    // R's area facing the light of a sender, for the error estimate: its projected area
+    // towards the sender when the sender is small and far, up to its whole area as the sender
     // widens (geometric error → 1) and its light may come from anywhere — a 10 m leaf seen
     // edge-on from the centre of a 1 mm leaf above it lights the small leaf fully.
-    double ExposedArea(std::uint32_t r, const glm::dvec3& omega, double geometricError) const {
-        const double projected = ProjectedArea(r, omega);
+    double ExposedArea(std::uint32_t r, double projected, double geometricError) const {
         return projected + geometricError * std::max(hierarchy_[r].areaM2 - projected, 0.0);
     }
 
@@ -664,7 +663,7 @@ class HrcSolver {
             // One direction stands for the whole patch and R for all its points.
             e.geometricError =
                 std::min(1.0, std::pow((R.radius + S.radius) / std::max(d, 1e-300), 2.0));
-            e.reach = e.geometric * ExposedArea(r, e.toSender, e.geometricError);
+            e.reach = e.geometric * ExposedArea(r, facing, e.geometricError);
             e.power = radiosity * e.reach;
         } else {
             // 1/d² between centroids, times the mean of 1/|x − y|² over the two nodes' spread
@@ -675,16 +674,19 @@ class HrcSolver {
                 std::max(glm::dot(gap, gap), 0.25 * std::pow(R.radius + S.radius, 2.0));
             const double spread = (R.spread * R.spread + S.spread * S.spread) / (3.0 * square);
             e.geometric = std::min(1.0 + spread, 2.0) / square;
-            // S of even radiosity B sends I = B P_S(ω) / π towards R, and B A_S in all:
-            // the link hands R's area facing S no more than that.
-            const double facing = ProjectedArea(r, e.toSender) * ProjectedArea(s, -e.toSender);
-            if (facing > 0.0) e.geometric = std::min(e.geometric, 2.0 * kPi * S.areaM2 / facing);
+            // S of even radiosity B on both sides sends I = B P_S(ω) / π towards R and
+            // 2 B A_S in all: the link hands R's area facing S no more than that.
+            const DirectionSet::Interpolation back = directions_.Locate(-e.toSender);
+            const double facing = ProjectedArea(r, e.toSender);
+            const double facingProduct = facing * ProjectedArea(s, -e.toSender, &back);
+            if (facingProduct > 0.0)
+                e.geometric = std::min(e.geometric, 2.0 * kPi * S.areaM2 / facingProduct);
             // The error bound does not trust the bounded transfer of overlapping clusters:
             // there, all the sender's power may land on the receiver.
             e.geometricError =
                 std::min(1.0, std::pow(R.radius + S.radius, 2.0) / std::max(d * d, 1e-300));
-            e.reach = ExposedArea(r, e.toSender, e.geometricError) / std::max(d * d, 1e-300);
-            e.power = Power(s, -e.toSender) * e.reach;
+            e.reach = ExposedArea(r, facing, e.geometricError) / std::max(d * d, 1e-300);
+            e.power = Power(s, -e.toSender, &back) * e.reach;
         }
         e.power = std::min(e.power, emitted_[s]);
         // Overlapping bounds: the direction between centroids says nothing (two leaves face
@@ -1604,7 +1606,8 @@ Solution SolveWithBands(const Scene& scene, const FlatScene& flat, const RayScen
         throw InternalError("hrc: a scene has 1 to " + std::to_string(kMaxBands) + " bands");
     } else {
         if (static_cast<int>(scene.bands.size()) == kBands) {
-            return HrcSolver<kBands>(scene, flat, rays, options).Run();
+            const ResourceClock clock;
+            return HrcSolver<kBands>(scene, flat, rays, options).Run(clock);
         }
         return SolveWithBands<kBands + 1>(scene, flat, rays, options);
     }
