@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """Compares per-leaf results of two solvers: `compare.py REFERENCE.csv OTHER.csv`.
-Prints, per band, the L2 error in % of the reference maximum (Soler 2003, Fig. 14) and the
-mean and 95th-percentile relative errors over lit leaves (5 % of the brightest or more)."""
+Prints, per band, the L2 error in % of the reference maximum (Soler 2003, Fig. 14), the
+mean and 95th-percentile relative errors over lit leaves (5 % of the brightest or more),
+and the mean signed error of each fifth of the leaves from the darkest to the brightest
+(in % of the maximum): a solver that spreads light too evenly is high in the first fifths
+and low in the last."""
 import csv
 import math
 import sys
@@ -30,6 +33,14 @@ def errors(reference, value, band):
     return 100 * l2, 100 * mean, 100 * p95
 
 
+def bias_by_fifth(reference, value, band):
+    """Mean signed error (% of max) of each fifth of the leaves, darkest first."""
+    keys = sorted((k for k in reference if k[1] == band), key=lambda k: reference[k])
+    largest = reference[keys[-1]]
+    fifths = [keys[len(keys) * i // 5:len(keys) * (i + 1) // 5] for i in range(5)]
+    return [100 * sum(value[k] - reference[k] for k in f) / len(f) / largest for f in fifths if f]
+
+
 def main():
     if len(sys.argv) != 3:
         sys.exit(__doc__)
@@ -37,6 +48,8 @@ def main():
     for band in sorted({k[1] for k in reference}):
         l2, mean, p95 = errors(reference, value, band)
         print(f"{band}: L2 {l2:.2f} % of max, mean relative {mean:.2f} %, 95th percentile {p95:.2f} %")
+        fifths = " ".join(f"{b:+.2f}" for b in bias_by_fifth(reference, value, band))
+        print(f"{band}: mean signed error by fifth, darkest to brightest (% of max): {fifths}")
 
 
 if __name__ == "__main__":
