@@ -574,10 +574,10 @@ class HrcSolver {
         return Verdict::kNone;
     }
 
-    // R's area facing the light of a sender, for the error estimate: its projected area
-    // towards the sender when the sender is small and far, up to its whole area as the sender
-    // widens (geometric error → 1) and its light may come from anywhere — a 10 m leaf seen
-    // edge-on from the centre of a 1 mm leaf above it lights the small leaf fully.
+    // R's area facing the light of a sender, for the error estimate: its area projected
+    // towards the sender when the sender is small and far, up to its whole area as the
+    // sender widens (geometric error → 1) and its light may come from anywhere — a 10 m leaf
+    // seen edge-on from the centre of a 1 mm leaf above it lights the small leaf fully.
     double ExposedArea(std::uint32_t r, double projected, double geometricError) const {
         return projected + geometricError * std::max(hierarchy_[r].areaM2 - projected, 0.0);
     }
