@@ -11,6 +11,22 @@
 #include <vector>
 
 namespace leaflux {
+namespace {
+
+// A read or send interrupted by a signal (SIGINT, SIGTERM) is made again: the serving
+// loop sees `stop` at its next poll, never after half a message.
+template <class Call>
+auto AgainOnSignal(Call call) {
+    for (;;) {
+        try {
+            return call();
+        } catch (const zmq::error_t& e) {
+            if (e.num() != EINTR) throw;
+        }
+    }
+}
+
+}  // namespace
 
 CurveKeyPair CurveKeyPair::Generate() {
     char publicKey[41], secretKey[41];
@@ -78,7 +94,7 @@ void RouterServer::Serve(const Dispatch& dispatch, const std::function<std::stri
         }
         if (items[1].revents & ZMQ_POLLIN) {
             zmq::message_t ignored;
-            while (pull.recv(ignored, zmq::recv_flags::dontwait)) {
+            while (AgainOnSignal([&] { return pull.recv(ignored, zmq::recv_flags::dontwait); })) {
             }
             std::deque<std::pair<std::vector<std::string>, std::string>> ready;
             {
@@ -86,9 +102,12 @@ void RouterServer::Serve(const Dispatch& dispatch, const std::function<std::stri
                 ready.swap(outbox->replies);
             }
             for (auto& [envelope, reply] : ready) {
-                for (const std::string& frame : envelope)
-                    socket_.send(zmq::buffer(frame), zmq::send_flags::sndmore);
-                socket_.send(zmq::buffer(reply), zmq::send_flags::none);
+                for (const std::string& frame : envelope) {
+                    AgainOnSignal(
+                        [&] { return socket_.send(zmq::buffer(frame), zmq::send_flags::sndmore); });
+                }
+                AgainOnSignal(
+                    [&] { return socket_.send(zmq::buffer(reply), zmq::send_flags::none); });
                 if (stopAfterReply()) return;
             }
         }
@@ -99,7 +118,7 @@ void RouterServer::Serve(const Dispatch& dispatch, const std::function<std::stri
         bool more = true;
         while (more) {
             zmq::message_t frame;
-            if (!socket_.recv(frame, zmq::recv_flags::none)) break;
+            if (!AgainOnSignal([&] { return socket_.recv(frame, zmq::recv_flags::none); })) break;
             more = frame.more();
             ++count;
             bytes += frame.size();
