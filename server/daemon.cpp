@@ -96,7 +96,7 @@ SolverSettings SettingsFromProto(const v1::SolverSettings& in) {
 }
 
 void BandsToProto(const Scene& scene, const std::vector<BandLight>& bands,
-                  const std::vector<int>& wanted,
+                  const std::vector<int>& wanted, bool lightVectors,
                   google::protobuf::RepeatedPtrField<v1::BandLight>* out) {
     for (int b : wanted) {
         const BandLight& light = bands[b];
@@ -105,10 +105,12 @@ void BandsToProto(const Scene& scene, const std::vector<BandLight>& bands,
         band->set_irradiance_upper_wm2(light.irradianceUpperWm2);
         band->set_irradiance_lower_wm2(light.irradianceLowerWm2);
         band->set_absorbed_w(light.absorbedW);
-        const glm::dvec3 v = light.LightVector();
-        band->mutable_light_vector()->set_x(v.x);
-        band->mutable_light_vector()->set_y(v.y);
-        band->mutable_light_vector()->set_z(v.z);
+        if (lightVectors) {
+            const glm::dvec3 v = light.LightVector();
+            band->mutable_light_vector()->set_x(v.x);
+            band->mutable_light_vector()->set_y(v.y);
+            band->mutable_light_vector()->set_z(v.z);
+        }
         band->set_stderr_upper_wm2(light.stderrUpperWm2);
         band->set_stderr_lower_wm2(light.stderrLowerWm2);
     }
@@ -236,11 +238,14 @@ v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outp
     const Scene subset = allBands ? Scene{} : WithBands(scene, wanted);
     const Scene& solved = allBands ? scene : subset;
     if (!allBands) wanted = order;
+    const bool lightVectors = !outputs.has_light_vectors() || outputs.light_vectors();
+    SolverSettings settings = settings_;
+    settings.hrc.lightVectors = lightVectors;
     Clock::time_point start = Clock::now();
     const PreparedScene prepared(solved);
     spdlog::debug("scene flattened and its ray engine built in {:.1f} ms", Milliseconds(start));
     start = Clock::now();
-    const Solution solution = leaflux::Solve(prepared, settings_);
+    const Solution solution = leaflux::Solve(prepared, settings);
     spdlog::debug("solved in {:.1f} ms", Milliseconds(start));
     v1::CycleResult result;
     if (outputs.leaves()) {
@@ -250,7 +255,7 @@ v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outp
             organ->set_node(receiver.node);
             organ->set_name(receiver.name);
             organ->set_area_m2(receiver.areaM2);
-            BandsToProto(solved, solution.light[r], wanted, organ->mutable_bands());
+            BandsToProto(solved, solution.light[r], wanted, lightVectors, organ->mutable_bands());
         }
     }
     if (outputs.structures()) {
@@ -261,7 +266,7 @@ v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outp
             structure->set_type(TypeToProto(s.type));
             structure->set_organs(s.organCount);
             structure->set_area_m2(s.areaM2);
-            BandsToProto(solved, s.bands, wanted, structure->mutable_bands());
+            BandsToProto(solved, s.bands, wanted, lightVectors, structure->mutable_bands());
         }
     }
     v1::SolveStatistics* stats = result.mutable_statistics();

@@ -658,6 +658,33 @@ TEST(DaemonBands, OnlyTheRequestedBandsAreSolvedAndSent) {
     EXPECT_EQ(daemon.Handle(one).error().code(), v1::ERROR_CODE_ALREADY_EXISTS);
 }
 
+// A cycle asking no light vectors gets none, and the same irradiance: the solver skips only
+// the gathering of the light's directions.
+TEST(DaemonOutputs, LightVectorsOnlyWhenAsked) {
+    v1::Request open = OpenRequest();
+    *open.mutable_open_session()->mutable_scene()->add_nodes() = Leaf(3, 1, 0.02, 0.9);
+    Daemon daemon;
+    const std::string session = daemon.Handle(open).opened().session();
+    const v1::Reply with = daemon.Handle(CycleRequest(session, 1));
+    ASSERT_TRUE(with.has_cycle()) << with.DebugString();
+    v1::Request request = CycleRequest(session, 2);
+    request.mutable_cycle()->mutable_outputs()->set_light_vectors(false);
+    const v1::Reply without = daemon.Handle(request);
+    ASSERT_TRUE(without.has_cycle()) << without.DebugString();
+    EXPECT_FALSE(without.cycle().statistics().reused());
+    ASSERT_EQ(without.cycle().organs_size(), with.cycle().organs_size());
+    for (int i = 0; i < with.cycle().organs_size(); ++i) {
+        const v1::BandLight& a = with.cycle().organs(i).bands(0);
+        const v1::BandLight& b = without.cycle().organs(i).bands(0);
+        EXPECT_TRUE(a.has_light_vector());
+        EXPECT_FALSE(b.has_light_vector());
+        EXPECT_EQ(b.irradiance_upper_wm2(), a.irradiance_upper_wm2());
+        EXPECT_EQ(b.irradiance_lower_wm2(), a.irradiance_lower_wm2());
+        EXPECT_EQ(b.absorbed_w(), a.absorbed_w());
+    }
+    EXPECT_GT(with.cycle().organs(0).bands(0).light_vector().z(), 0.5);  // the sun is above
+}
+
 // --solver-threads caps the cores of every solve; a session asking fewer gets fewer.
 TEST(DaemonThreads, SolvesUseAtMostTheDaemonsSolverThreads) {
     for (const auto& [limit, asked, used] : {std::tuple{1, 0, 1}, {1, 2, 1}, {2, 1, 1}}) {

@@ -1484,7 +1484,12 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
                       sweep + 1, sweepSeconds, clock.Lap());
         ++iteration;
     }
-    if (!options_.directOnly) Collect<true>();  // the light vectors, from the solution's light
+    // The last light, with its vectors when they are wanted, from the solution's radiosity.
+    if (options_.lightVectors && !options_.directOnly) {
+        Collect<true>();
+    } else if (!options_.directOnly) {
+        Collect<false>();
+    }
     solution.stats.iterations = std::min(iteration + 1, iterations);
     solution.stats.residual = convergence.Remaining(residual);
     const std::int64_t passRays = rayCount_ - sourceRays - refineRays;

@@ -45,6 +45,9 @@ struct HrcOptions {
     // Direct light only: one gathering sweep from the sources and lamps, no links for
     // light scattered by leaves and surfaces (it shows as missing in the energy balance).
     bool directOnly = false;
+    // The light vectors (∫ L dω, ∫ L ω dω per leaf): false leaves them zero and gathers
+    // only each side's irradiance.
+    bool lightVectors = true;
     int threads = 0;  // 0: every core
     // A continuous sky is discretised into these cones for the hierarchy's links.
     SkyDiscretization skyCones = SkyDiscretization::kTurtle46;
