@@ -1,5 +1,6 @@
 #include "solver/radiosity/form_factor.h"
 
+#include <array>
 #include <cmath>
 #include <glm/gtc/constants.hpp>
 
@@ -8,29 +9,34 @@
 namespace leaflux {
 namespace {
 
-// The part of the polygon where n · (p − x) ≥ 0 (Sutherland–Hodgman on one plane).
-std::vector<glm::dvec3> ClipAbove(const glm::dvec3& x, const glm::dvec3& n,
-                                  const std::vector<glm::dvec3>& polygon) {
-    std::vector<glm::dvec3> out;
-    for (std::size_t i = 0; i < polygon.size(); ++i) {
-        const glm::dvec3& p = polygon[i];
-        const glm::dvec3& q = polygon[(i + 1) % polygon.size()];
+// A triangle clipped by one plane: at most four corners, on the stack (form factors are
+// found for every pair of patches refinement judges).
+struct Clipped {
+    std::array<glm::dvec3, 4> corners;
+    std::size_t count = 0;
+};
+
+// The part of the triangle where n · (p − x) ≥ 0 (Sutherland–Hodgman on one plane).
+Clipped ClipAbove(const glm::dvec3& x, const glm::dvec3& n,
+                  const std::array<glm::dvec3, 3>& triangle) {
+    Clipped out;
+    for (std::size_t i = 0; i < triangle.size(); ++i) {
+        const glm::dvec3& p = triangle[i];
+        const glm::dvec3& q = triangle[(i + 1) % triangle.size()];
         const double dp = glm::dot(n, p - x), dq = glm::dot(n, q - x);
-        if (dp >= 0.0) out.push_back(p);
-        if ((dp >= 0.0) != (dq >= 0.0)) out.push_back(p + (q - p) * (dp / (dp - dq)));
+        if (dp >= 0.0) out.corners[out.count++] = p;
+        if ((dp >= 0.0) != (dq >= 0.0)) out.corners[out.count++] = p + (q - p) * (dp / (dp - dq));
     }
     return out;
 }
 
-}  // namespace
-
-double PointToPolygonAbove(const glm::dvec3& x, const glm::dvec3& n,
-                           const std::vector<glm::dvec3>& polygon) {
-    if (polygon.size() < 3) return 0.0;
+double Above(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3* polygon,
+             std::size_t count) {
+    if (count < 3) return 0.0;
     double sum = 0.0;
-    for (std::size_t i = 0; i < polygon.size(); ++i) {
+    for (std::size_t i = 0; i < count; ++i) {
         const glm::dvec3 r0 = polygon[i] - x;
-        const glm::dvec3 r1 = polygon[(i + 1) % polygon.size()] - x;
+        const glm::dvec3 r1 = polygon[(i + 1) % count] - x;
         const glm::dvec3 cross = glm::cross(r0, r1);
         const double length = glm::length(cross);
         if (length <= 0.0) continue;  // an edge seen end-on adds nothing
@@ -40,12 +46,20 @@ double PointToPolygonAbove(const glm::dvec3& x, const glm::dvec3& n,
     return std::min(1.0, std::abs(sum) / (2.0 * glm::pi<double>()));
 }
 
+}  // namespace
+
+double PointToPolygonAbove(const glm::dvec3& x, const glm::dvec3& n,
+                           const std::vector<glm::dvec3>& polygon) {
+    return Above(x, n, polygon.data(), polygon.size());
+}
+
 SidedFormFactor PointToTriangle(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3& a,
                                 const glm::dvec3& b, const glm::dvec3& c) {
-    const std::vector<glm::dvec3> triangle = {a, b, c};
+    const std::array<glm::dvec3, 3> triangle = {a, b, c};
     SidedFormFactor f;
-    f.upper = PointToPolygonAbove(x, n, ClipAbove(x, n, triangle));
-    f.lower = PointToPolygonAbove(x, -n, ClipAbove(x, -n, triangle));
+    const Clipped upper = ClipAbove(x, n, triangle), lower = ClipAbove(x, -n, triangle);
+    f.upper = Above(x, n, upper.corners.data(), upper.count);
+    f.lower = Above(x, -n, lower.corners.data(), lower.count);
     const glm::dvec3 ra = a - x, rb = b - x, rc = c - x;
     const double la = glm::length(ra), lb = glm::length(rb), lc = glm::length(rc);
     if (la > 0.0 && lb > 0.0 && lc > 0.0) {
