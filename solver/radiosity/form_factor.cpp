@@ -30,8 +30,10 @@ Clipped ClipAbove(const glm::dvec3& x, const glm::dvec3& n,
     return out;
 }
 
-double Above(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3* polygon,
-             std::size_t count) {
+// F from a differential element at x (normal n) to the polygon lying entirely on the +n
+// side of x's plane.
+double PolygonAbove(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3* polygon,
+                    std::size_t count) {
     if (count < 3) return 0.0;
     double sum = 0.0;
     for (std::size_t i = 0; i < count; ++i) {
@@ -48,18 +50,13 @@ double Above(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3* polygon
 
 }  // namespace
 
-double PointToPolygonAbove(const glm::dvec3& x, const glm::dvec3& n,
-                           const std::vector<glm::dvec3>& polygon) {
-    return Above(x, n, polygon.data(), polygon.size());
-}
-
 SidedFormFactor PointToTriangle(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3& a,
                                 const glm::dvec3& b, const glm::dvec3& c) {
     const std::array<glm::dvec3, 3> triangle = {a, b, c};
     SidedFormFactor f;
     const Clipped upper = ClipAbove(x, n, triangle), lower = ClipAbove(x, -n, triangle);
-    f.upper = Above(x, n, upper.corners.data(), upper.count);
-    f.lower = Above(x, -n, lower.corners.data(), lower.count);
+    f.upper = PolygonAbove(x, n, upper.corners.data(), upper.count);
+    f.lower = PolygonAbove(x, -n, lower.corners.data(), lower.count);
     const glm::dvec3 ra = a - x, rb = b - x, rc = c - x;
     const double la = glm::length(ra), lb = glm::length(rb), lc = glm::length(rc);
     if (la > 0.0 && lb > 0.0 && lc > 0.0) {

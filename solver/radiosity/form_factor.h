@@ -5,7 +5,6 @@
 #pragma once
 
 #include <glm/glm.hpp>
-#include <vector>
 
 namespace leaflux {
 
@@ -19,10 +18,5 @@ struct SidedFormFactor {
 // x: the triangle is clipped by the plane of x and each part seen by its side.
 SidedFormFactor PointToTriangle(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3& a,
                                 const glm::dvec3& b, const glm::dvec3& c);
-
-// F from a differential element at x (normal n) to the polygon lying entirely on the +n
-// side of x's plane.
-double PointToPolygonAbove(const glm::dvec3& x, const glm::dvec3& n,
-                           const std::vector<glm::dvec3>& polygon);
 
 }  // namespace leaflux
