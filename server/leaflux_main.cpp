@@ -92,6 +92,14 @@ int RunSolve(const SolveCommand& command) {
         WritePly(ply, prepared.Flat(), solution, 0);
     }
     std::cout << Summary(command.solver, scene, prepared.Flat(), solution) << std::endl;
+    for (const LinkAudit& audit : solution.linkAudit) {
+        if (audit.links == 0) continue;
+        std::printf(
+            "links %-24s %9lld: hand on %.6g W, rays from their senders land %.6g ± %.2g W"
+            " (ratio %.4f)\n",
+            audit.kind.c_str(), static_cast<long long>(audit.links), audit.handedW, audit.shotW,
+            audit.shotStderrW, audit.handedW / audit.shotW);
+    }
     return 0;
 }
 
@@ -261,6 +269,9 @@ int main(int argc, char** argv) {
             "hrc: largest error of a link, as a fraction of the power the sources bring in")
         ->check(CLI::Range(1e-9, 1.0));
     AddHrcSettings(*solveApp, solve.hrc, "--", "hrc: ");
+    solveApp->add_flag("--audit-links", solve.hrc.auditLinks,
+                       "hrc: after the solve, set each kind of link against 64 rays shot from "
+                       "each link's sender (the power handed on, with the solution's radiosity)");
     solveApp
         ->add_option("--samples", solve.samples, "mc: paths per receiver (standard error ~ 1/sqrt)")
         ->check(CLI::Range(2, 1 << 26));

@@ -69,10 +69,22 @@ class ResourceClock {
     double wallStart_, cpuStart_;
 };
 
+// HRC's links of one kind against rays shot from their senders (HrcOptions::auditLinks):
+// the power the links hand on with the solution's radiosity, all bands together, and the
+// power that cosine-distributed rays from each sender, weighted by the radiosity of the
+// side they leave, land on its receiver first — a Monte Carlo estimate of the same
+// exchanges, with its standard error.
+struct LinkAudit {
+    std::string kind;
+    std::int64_t links = 0;
+    double handedW = 0.0, shotW = 0.0, shotStderrW = 0.0;
+};
+
 struct Solution {
     std::vector<std::vector<BandLight>> light;  // [receiver][band]
     std::vector<EnergyBalance> balance;         // [band]
     SolveStats stats;
+    std::vector<LinkAudit> linkAudit;  // HRC with auditLinks only
 };
 
 // The same quantities for a botanical structure (branch, plant, …): the organs below it,

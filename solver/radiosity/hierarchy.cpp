@@ -74,6 +74,9 @@ Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat) : flat_(flat) {
     root_ = top.size() == 1 ? top[0] : Constrain(std::move(top));
     cumulativeArea_.push_back(0.0);
     Finish(root_);
+    orderOf_.assign(flat.triangles.size(), 0);
+    for (std::size_t i = 0; i < triangleOrder_.size(); ++i)
+        orderOf_[triangleOrder_[i]] = static_cast<std::uint32_t>(i);
 }
 
 std::uint32_t Hierarchy::AddPatch(std::uint32_t triangle) {
@@ -261,6 +264,19 @@ Hierarchy::Point Hierarchy::Sample(std::uint32_t index, double u, double v) cons
     }
     const glm::dvec3 w = UniformTriangle(u, v);
     return {w.x * a + w.y * b + w.z * c, flat_.triangles[triangle].normal, triangle};
+}
+
+bool Hierarchy::Covers(std::uint32_t index, std::uint32_t triangle, const glm::dvec3& x) const {
+    const HrcNode& node = nodes_[index];
+    const std::uint32_t at = orderOf_[triangle];
+    if (at < node.first || at >= node.first + node.count) return false;
+    if (!node.patch || node.depth == 0) return true;
+    // A part of a split triangle: x within its corners (barycentric, in its plane).
+    const glm::dvec3 n = glm::cross(node.b - node.a, node.c - node.a);
+    const double area2 = glm::dot(n, n);
+    const double u = glm::dot(glm::cross(node.c - node.b, x - node.b), n) / area2;
+    const double v = glm::dot(glm::cross(node.a - node.c, x - node.c), n) / area2;
+    return u >= 0.0 && v >= 0.0 && u + v <= 1.0;
 }
 
 }  // namespace leaflux

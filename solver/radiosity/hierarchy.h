@@ -62,6 +62,9 @@ class Hierarchy {
     };
     Point Sample(std::uint32_t node, double u, double v) const;
 
+    // Whether the point x of flat triangle `triangle` lies on the node's surfaces.
+    bool Covers(std::uint32_t node, std::uint32_t triangle, const glm::dvec3& x) const;
+
   private:
     std::uint32_t AddPatch(std::uint32_t triangle);
     std::uint32_t AddCluster(std::vector<std::uint32_t> children);
@@ -73,6 +76,7 @@ class Hierarchy {
     std::vector<HrcNode> nodes_;
     std::vector<std::uint32_t> triangleOrder_;  // flat triangles in hierarchy order
     std::vector<double> cumulativeArea_;        // over triangleOrder_, starting at 0
+    std::vector<std::uint32_t> orderOf_;        // by flat triangle: its place in triangleOrder_
     std::uint32_t root_ = kNoNode;
 };
 

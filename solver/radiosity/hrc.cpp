@@ -973,6 +973,7 @@ class HrcSolver {
     double UpdateRadiosity();
     void Extrapolate(double factor);
     void Outputs(Solution& solution);
+    void AuditLinks(Solution& solution) const;
 
     const Scene& scene_;
     const FlatScene& flat_;
@@ -1492,6 +1493,7 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
     }
     solution.stats.iterations = std::min(iteration + 1, iterations);
     solution.stats.residual = convergence.Remaining(residual);
+    if (options_.auditLinks) AuditLinks(solution);
     const std::int64_t passRays = rayCount_ - sourceRays - refineRays;
     Outputs(solution);
     spdlog::debug(
@@ -1499,6 +1501,86 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
         "passes), outputs {:.3f} s ({} rays)",
         sourceSeconds, sourceRays, refineSeconds, refineRays, passRays, clock.Lap(),
         rayCount_ - sourceRays - refineRays - passRays);
+}
+
+template <int kBands>
+void HrcSolver<kBands>::AuditLinks(Solution& solution) const {
+    // The radiosity at a point a sender's ray leaves from: its patch's, or for a cluster the
+    // flat triangle's (the mean of its parts).
+    std::vector<std::uint32_t> patchOf(flat_.triangles.size(), kNoNode);
+    for (std::uint32_t n = 0; n < hierarchy_.Size(); ++n) {
+        if (hierarchy_[n].patch && hierarchy_[n].depth == 0) patchOf[hierarchy_[n].triangle] = n;
+    }
+    enum Kind { kExact, kFromPatch, kFromCluster, kKinds };
+    struct Sum {
+        std::int64_t links = 0;
+        double handed = 0.0, shot = 0.0, variance = 0.0;
+        Sum& operator+=(const Sum& o) {
+            links += o.links, handed += o.handed, shot += o.shot, variance += o.variance;
+            return *this;
+        }
+    };
+    using Sums = std::array<Sum, kKinds>;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> all;  // receiver, link
+    for (std::uint32_t r = 0; r < links_.size(); ++r) {
+        for (std::uint32_t i = 0; i < links_[r].size(); ++i) all.push_back({r, i});
+    }
+    constexpr int kShots = 64;
+    using Range = tbb::blocked_range<std::size_t>;
+    const Sums sums = tbb::parallel_reduce(
+        Range(0, all.size()), Sums{},
+        [&](const Range& range, Sums acc) {
+            SetFlushToZero();
+            for (std::size_t j = range.begin(); j != range.end(); ++j) {
+                const auto [r, i] = all[j];
+                const NodeLink& link = links_[r][i];
+                const HrcNode& S = hierarchy_[link.sender];
+                Sum& sum = acc[link.exact ? kExact : link.senderPatch ? kFromPatch : kFromCluster];
+                ++sum.links;
+                if (link.exact) {
+                    sum.handed += static_cast<double>(link.transfer[0] + link.transfer[1]) *
+                                  hierarchy_[r].areaM2 *
+                                  SideRadiosity(link.sender, link.senderSide);
+                } else if (link.Carries()) {
+                    const Spectrum sent = Sent(link);
+                    sum.handed += std::accumulate(sent.begin(), sent.begin() + bands_, 0.0) *
+                                  static_cast<double>(link.transfer[0]) *
+                                  ProjectedArea(r, glm::dvec3(link.toSender));
+                }
+                Random random(StreamSeed(0xA0D17, r, link.sender));
+                double shot = 0.0, square = 0.0;
+                for (int k = 0; k < kShots; ++k) {
+                    const int side = k % 2;
+                    const Hierarchy::Point p =
+                        hierarchy_.Sample(link.sender, random.Uniform(), random.Uniform());
+                    const glm::dvec3 omega = CosineHemisphere(side == kUpper ? p.normal : -p.normal,
+                                                              random.Uniform(), random.Uniform());
+                    const RayHit hit = rays_.Trace({p.position, p.triangle}, omega);
+                    if (hit.fate != RayFate::kHit ||
+                        !hierarchy_.Covers(r, hit.triangle, hit.next.origin))
+                        continue;
+                    // Both sides of S send: 2 A_S B over the rays of both.
+                    const double w =
+                        2.0 * S.areaM2 *
+                        SideRadiosity(S.patch ? link.sender : patchOf[p.triangle], side);
+                    shot += w;
+                    square += w * w;
+                }
+                const double mean = shot / kShots;
+                sum.shot += mean;
+                sum.variance += (square / kShots - mean * mean) / (kShots - 1);
+            }
+            return acc;
+        },
+        [](Sums a, const Sums& b) {
+            for (int k = 0; k < kKinds; ++k) a[k] += b[k];
+            return a;
+        });
+    const char* names[kKinds] = {"patch from patch (exact)", "from a patch", "from a cluster"};
+    for (int k = 0; k < kKinds; ++k) {
+        solution.linkAudit.push_back(
+            {names[k], sums[k].links, sums[k].handed, sums[k].shot, std::sqrt(sums[k].variance)});
+    }
 }
 
 template <int kBands>
