@@ -289,9 +289,8 @@ TEST(HrcTree, LinkAuditLandsAllTheLightThatDoesNotEscape) {
         if (receiver.optics < 0) continue;
         const BandOptics& o = scene.optics[receiver.optics].bands[0];
         const BandLight& e = hrc.light[r][0];
-        sent += receiver.areaM2 *
-                ((o.rhoUpper + o.tauUpperToLower) * e.irradianceUpperWm2 +
-                 (o.rhoLower + o.tauLowerToUpper) * e.irradianceLowerWm2);
+        sent += receiver.areaM2 * ((o.rhoUpper + o.tauUpperToLower) * e.irradianceUpperWm2 +
+                                   (o.rhoLower + o.tauLowerToUpper) * e.irradianceLowerWm2);
     }
     double landed = 0.0, variance = hrc.balance[0].stderrW * hrc.balance[0].stderrW;
     for (const LinkAudit& audit : hrc.linkAudit) {
