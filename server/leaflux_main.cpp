@@ -93,7 +93,7 @@ int RunSolve(const SolveCommand& command) {
     }
     std::cout << Summary(command.solver, scene, prepared.Flat(), solution) << std::endl;
     for (const LinkAudit& audit : solution.linkAudit) {
-        if (audit.links == 0) continue;
+        if (audit.links == 0 || audit.shotW <= 0.0) continue;  // nothing to set it against
         std::printf(
             "links %-24s %9lld: hand on %.6g W, rays from their senders land %.6g ± %.2g W"
             " (ratio %.4f)\n",
