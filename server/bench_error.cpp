@@ -170,6 +170,8 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
         hrcSetting += " rays=" + std::to_string(options.hrc.visibilityRays);
     if (options.hrc.sourceRays != defaults.sourceRays)
         hrcSetting += " source-rays=" + std::to_string(options.hrc.sourceRays);
+    if (options.hrc.clusterTolerance != defaults.clusterTolerance)
+        hrcSetting += " cluster-tolerance=" + Number(options.hrc.clusterTolerance);
     if (options.hrc.directionLevel != defaults.directionLevel)
         hrcSetting += " directions=" + std::to_string(options.hrc.directionLevel);
     for (int samples : options.monteCarloSamples) {

@@ -44,6 +44,11 @@ void AddHrcSettings(CLI::App& app, HrcOptions& hrc, const std::string& prefix,
     app.add_option(prefix + "source-rays", hrc.sourceRays,
                    label + "rays estimating the visibility of each link from a sun or sky cone")
         ->check(CLI::Range(1, 1024));
+    app.add_option(
+           prefix + "cluster-tolerance", hrc.clusterTolerance,
+           label +
+               "error a link from a surface into a cluster of organs may carry, as a fraction of ε")
+        ->check(CLI::Range(1e-3, 1.0));
     app.add_option(prefix + "direction-level", hrc.directionLevel,
                    label + "direction set of cluster light, 0..4 (4, 10, 34, 130, 514 directions)")
         ->check(CLI::Range(0, 4));

@@ -205,6 +205,7 @@ class HrcSolver {
           bands_(static_cast<int>(scene.bands.size())),
           bins_(directions_.Size()) {
         for (const Receiver& receiver : flat.receivers) optics_.push_back(OpticsOf(receiver));
+        FindOrgans();
         FindInnerSides(scene);
         for (const Sun& sun : scene.sources.suns) AddSource(sun.towardSun, sun.normalIrradianceWm2);
         for (const Sky& sky : scene.sources.skies) {
@@ -548,7 +549,7 @@ class HrcSolver {
         if (unoccluded <= 0.0) return {};
         // The spread is least when every ray agrees: beyond ε even then, no ray can save
         // the link, and none is traced.
-        const double threshold = options_.epsilon * totalPower_;
+        const double threshold = SourceThreshold(r);
         if (unoccluded * VisibilitySpread(1.0, options_.sourceRays) > threshold && CanSplit(r))
             return {Verdict::kSplitReceiver, {}, 0.0f, 0};
         Verdict verdict;
@@ -561,6 +562,38 @@ class HrcSolver {
             verdict.visibility = static_cast<float>(v);
         }
         return verdict;
+    }
+
+    // Marks the clusters with an organ under them (a cluster's children come before it).
+    void FindOrgans() {
+        organs_.assign(hierarchy_.Size(), 0);
+        for (std::uint32_t n = 0; n < hierarchy_.Size(); ++n) {
+            const HrcNode& node = hierarchy_[n];
+            if (node.patch) {
+                organs_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kOrgan;
+            } else {
+                for (std::uint32_t child : node.children) organs_[n] |= organs_[child];
+            }
+        }
+    }
+
+    // Whether a link into node r hands the same light to organs that may see it unevenly:
+    // r is a cluster with organs under it (HrcOptions::clusterTolerance).
+    bool Shared(std::uint32_t r) const { return !hierarchy_[r].patch && organs_[r]; }
+
+    // The error a link into node r may carry (W): ε of the power the sources bring in, or
+    // into a cluster of organs the share HrcOptions::clusterTolerance says.
+    double Threshold(std::uint32_t r) const {
+        const double threshold = options_.epsilon * totalPower_;
+        return Shared(r) ? threshold * options_.clusterTolerance : threshold;
+    }
+    // The same for a link from a sun or sky cone: into a cluster of organs, ε / √(number of
+    // sources), for the errors of its links from all the sources share their sign on each
+    // organ under it and add up, where a patch's average out as the root of their number.
+    double SourceThreshold(std::uint32_t r) const {
+        const double threshold = options_.epsilon * totalPower_;
+        const auto sources = static_cast<double>(std::max<std::size_t>(sources_.size(), 1));
+        return Shared(r) ? threshold / std::sqrt(sources) : threshold;
     }
 
     // Which of r and s a link between them splits: the larger, or the other when the
@@ -758,7 +791,7 @@ class HrcSolver {
         if (exact && !e.near && e.form.upper + e.form.lower <= 0.0) return {};
         // Geometry and the least spread any rays could show may call for a split: then no
         // visibility rays are spent on it.
-        const double threshold = options_.epsilon * totalPower_;
+        const double threshold = Threshold(r);
         if (Error(e, VisibilitySpread(1.0, options_.visibilityRays)) > threshold) {
             if (const auto split = SplitChoice(r, s); split != Verdict::kNone)
                 return {split, {}, 0.0f, 0};
@@ -863,7 +896,6 @@ class HrcSolver {
     // solution, every link is judged again and split where its error now exceeds ε (the
     // classic refine–solve loop of hierarchical radiosity). True when a link was split.
     bool Rerefine() {
-        const double threshold = options_.epsilon * totalPower_;
         const std::size_t count = links_.size();
         // Per receiver, in parallel: the links that fail move to the end of its list; those
         // kept now only because their rays agreed take rays of their own (Value).
@@ -871,6 +903,7 @@ class HrcSolver {
         std::atomic<std::int64_t> valueRays{0};
         tbb::parallel_for(std::size_t{0}, count, [&](std::size_t r) {
             auto& links = links_[r];
+            const double threshold = Threshold(static_cast<std::uint32_t>(r));
             const auto kept = std::stable_partition(
                 links.begin(), links.end(),
                 [&](const NodeLink& link) { return LinkError(link, link.Spread()) <= threshold; });
@@ -984,7 +1017,8 @@ class HrcSolver {
     const int bands_;
     const int bins_;
     std::vector<SideOptics> optics_;
-    std::vector<std::uint8_t> inner_;  // by flat triangle: bit s set when side s is inside
+    std::vector<std::uint8_t> inner_;   // by flat triangle: bit s set when side s is inside
+    std::vector<std::uint8_t> organs_;  // by node of the hierarchy as built: 1 over an organ
     std::vector<DirectionalSource> sources_;
     double totalPower_ = 0.0;
     std::int64_t rayCount_ = 0;
