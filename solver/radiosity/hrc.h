@@ -14,9 +14,8 @@
 // estimated error — the power it carries times its geometric error ((r_R + r_S)/d)² plus
 // its visibility spread 2√(v(1−v)), v the fraction of its rays that pass — exceeds ε times
 // the power the sources bring into the scene (less for links into clusters of organs,
-// HrcOptions::clusterTolerance); the candidate links are judged in parallel
-// chunks and the verdicts carried out in order, so the links do not depend on the number of
-// threads. A link kept only because its rays agreed takes its transfer from rays of its own,
+// HrcOptions::clusterTolerance); the candidate links are judged in parallel chunks and the
+// verdicts carried out in order, so the links do not depend on the number of threads. A link kept only because its rays agreed takes its transfer from rays of its own,
 // so that the choice of links does not bias the light they carry. Solution: Jacobi gathering with
 // push/pull (B₁ = ρ₁I₁ + τ₂→₁I₂, B₂ = ρ₂I₂ + τ₁→₂I₁; what is pulled up is the intensity of both
 // sides), accelerated by extrapolating the geometric series of the changes and iterated until the
