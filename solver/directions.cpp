@@ -75,6 +75,32 @@ DirectionSet::DirectionSet(int level) {
         solidAngles_[b] += third;
         solidAngles_[c] += third;
     }
+    // The weights are barycentric on the face's plane (gnomonic): each face is cut into
+    // m² small triangles on that plane, whose solid angles are exact, each weighted by the
+    // weights at its centre (midpoint rule; m² = 4096 per face of the tetrahedron, 16 per
+    // face of level 4).
+    const int m = std::max(4, 64 >> level);
+    hatIntegrals_.assign(directions_.size(), 0.0);
+    for (const auto& [a, b, c] : faces_) {
+        const auto on = [&](const glm::dvec2& p) {  // p: weights of b and c
+            return glm::normalize((1.0 - p.x - p.y) * directions_[a] + p.x * directions_[b] +
+                                  p.y * directions_[c]);
+        };
+        const auto add = [&](const glm::dvec2& p, const glm::dvec2& q, const glm::dvec2& r) {
+            const double omega = SphericalTriangleSolidAngle(on(p), on(q), on(r));
+            const Interpolation w = Locate(on((p + q + r) / 3.0));
+            for (int k = 0; k < 3; ++k) hatIntegrals_[w.vertex[k]] += omega * w.weight[k];
+        };
+        const double h = 1.0 / m;
+        for (int i = 0; i < m; ++i) {
+            for (int j = 0; i + j < m; ++j) {
+                const glm::dvec2 p(i * h, j * h);
+                add(p, p + glm::dvec2(h, 0.0), p + glm::dvec2(0.0, h));
+                if (i + j + 1 < m)
+                    add(p + glm::dvec2(h, 0.0), p + glm::dvec2(h, h), p + glm::dvec2(0.0, h));
+            }
+        }
+    }
 }
 
 const DirectionSet& DirectionSet::OfLevel(int level) {

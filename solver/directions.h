@@ -22,6 +22,10 @@ class DirectionSet {
     int Size() const { return static_cast<int>(directions_.size()); }
     const glm::dvec3& Direction(int i) const { return directions_[i]; }
     double SolidAngleSr(int i) const { return solidAngles_[i]; }
+    // ∫ over the sphere of direction i's interpolation weight (Locate), in sr: a function
+    // known at the directions, f_i, interpolated, integrates to Σ f_i HatIntegralSr(i).
+    // They sum to 4π.
+    double HatIntegralSr(int i) const { return hatIntegrals_[i]; }
     const std::vector<std::array<int, 3>>& Faces() const { return faces_; }
 
     struct Interpolation {
@@ -39,6 +43,7 @@ class DirectionSet {
 
     std::vector<glm::dvec3> directions_;
     std::vector<double> solidAngles_;
+    std::vector<double> hatIntegrals_;
     std::vector<std::array<int, 3>> faces_;
     // faces_ of every level, children of face f of level l at 4f..4f+3 of level l+1, so
     // that Locate descends the subdivision in O(level).

@@ -207,6 +207,7 @@ class HrcSolver {
         for (const Receiver& receiver : flat.receivers) optics_.push_back(OpticsOf(receiver));
         FindOrgans();
         FindInnerSides(scene);
+        ScaleLobes();
         for (const Sun& sun : scene.sources.suns) AddSource(sun.towardSun, sun.normalIrradianceWm2);
         for (const Sky& sky : scene.sources.skies) {
             Sky discrete = sky;
@@ -328,6 +329,38 @@ class HrcSolver {
                            const glm::dvec3& omega) const {
         const double cosine = glm::dot(n, omega);
         return Inner(triangle, cosine > 0.0 ? kUpper : kLower) ? 0.0 : std::abs(cosine);
+    }
+
+    // A patch's light reaches clusters, and a cluster's light reaches its patches, through
+    // the direction set: |n · ω| known at its directions and interpolated between them.
+    // Interpolated, that lobe does not integrate to π per side as |n · ω| does: a
+    // horizontal leaf's, 6 % short at level 2, since the zenith is a direction and the
+    // lobe is concave there (tilted 30°, 1 % over). Each side's lobe is scaled to
+    // integrate to π, so that a cluster sends all its patches send and its patches take
+    // all an even light brings it. The 500-leaf NIR canopy's balance went from 0.88 to
+    // 0.74 % at level 2, from −0.51 to −0.33 % at level 1 (its L2 error there from 1.78 to
+    // 1.49 %) and from 0.45 to 0.37 % at level 3. What is left of the lobe's error is in
+    // its shape between directions.
+    void ScaleLobes() {
+        lobeScale_.assign(flat_.triangles.size(), {1.0, 1.0});
+        for (std::size_t t = 0; t < flat_.triangles.size(); ++t) {
+            std::array<double, 2> integral{};
+            for (int d = 0; d < bins_; ++d) {
+                const double cosine = glm::dot(flat_.triangles[t].normal, directions_.Direction(d));
+                integral[cosine > 0.0 ? kUpper : kLower] +=
+                    std::abs(cosine) * directions_.HatIntegralSr(d);
+            }
+            for (int side : {kUpper, kLower}) {
+                if (integral[side] > 0.0) lobeScale_[t][side] = kPi / integral[side];
+            }
+        }
+    }
+
+    // The side of patch p facing direction d of the set and p's lobe there (ScaleLobes).
+    std::pair<int, double> BinCosine(const HrcNode& p, int d) const {
+        const double cosine = glm::dot(p.normal, directions_.Direction(d));
+        const int side = cosine > 0.0 ? kUpper : kLower;
+        return {side, std::abs(cosine) * lobeScale_[p.triangle][side]};
     }
 
     // What a link's rays show (Visibility).
@@ -1017,7 +1050,8 @@ class HrcSolver {
     const int bands_;
     const int bins_;
     std::vector<SideOptics> optics_;
-    std::vector<std::uint8_t> inner_;   // by flat triangle: bit s set when side s is inside
+    std::vector<std::uint8_t> inner_;  // by flat triangle: bit s set when side s is inside
+    std::vector<std::array<double, 2>> lobeScale_;  // by flat triangle and side: BinCosine
     std::vector<std::uint8_t> organs_;  // by node of the hierarchy as built: 1 over an organ
     std::vector<DirectionalSource> sources_;
     double totalPower_ = 0.0;
@@ -1080,9 +1114,11 @@ void HrcSolver<kBands>::Index() {
             const HrcNode& node = hierarchy_[*it];
             if (node.patch) continue;
             for (std::uint32_t child : node.children) {
+                const HrcNode& c = hierarchy_[child];
                 for (int d = 0; d < bins_; ++d) {
                     projected_[slot_[*it] * bins_ + d] +=
-                        ProjectedArea(child, directions_.Direction(d));
+                        c.patch ? c.areaM2 * BinCosine(c, d).second
+                                : projected_[slot_[child] * bins_ + d];
                 }
             }
         }
@@ -1203,9 +1239,8 @@ void HrcSolver<kBands>::PullNode(std::uint32_t n) {
             continue;
         }
         for (int d = 0; d < bins_; ++d) {
-            const double cosine = glm::dot(c.normal, directions_.Direction(d));
-            const int side = cosine > 0.0 ? kUpper : kLower;
-            const double scale = c.areaM2 * std::abs(cosine) / kPi;
+            const auto [side, lobe] = BinCosine(c, d);
+            const double scale = c.areaM2 * lobe / kPi;
             for (int b = 0; b < bands_; ++b)
                 out[d * bands_ + b] += scale * radiosity_[child][side][b];
         }
@@ -1364,12 +1399,11 @@ void HrcSolver<kBands>::PushDown() {
         Incoming in;
         for (int d = 0; d < bins_; ++d) {
             const glm::dvec3& omega = directions_.Direction(d);
-            const double cosine = glm::dot(node.normal, omega);
-            const int side = cosine > 0.0 ? kUpper : kLower;
+            const auto [side, lobe] = BinCosine(node, d);
             if (Inner(node.triangle, side)) continue;
             for (int k = 0; k < bands_; ++k) {
                 const double normal = bins[d * bands_ + k];
-                in.sides[side][k] += normal * std::abs(cosine);
+                in.sides[side][k] += normal * lobe;
                 if constexpr (kDirections) {
                     in.integral[k] += normal;
                     in.moment[k] += normal * omega;
