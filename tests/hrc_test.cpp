@@ -8,6 +8,7 @@
 #include "solver/accuracy.h"
 #include "solver/error.h"
 #include "solver/generator.h"
+#include "solver/radiosity/form_factor.h"
 #include "solver/solve.h"
 #include "tests/scene_builders.h"
 
@@ -165,6 +166,39 @@ TEST(HrcViewFactor, MatchesHowellWithinOnePercent) {
         const double e = s.light[0][0].irradianceUpperWm2 + s.light[0][0].irradianceLowerWm2;
         EXPECT_NEAR(e, 1000.0 * c.expected, 0.01 * 1000.0 * c.expected) << c.name;
     }
+}
+
+// Exact links into a patch take the form factor averaged over three points of it: each
+// point sees a closed cube's other faces with form factors summing to one, so their mean
+// does too (what keeps a closed room's light), and the mean is that of the three points
+// taken one by one.
+TEST(FormFactor, MeanOverPointsOfAFaceSumsToOneInsideACube) {
+    const glm::dvec3 n(0, 0, 1);  // the floor's triangle, facing in
+    const glm::dvec3 a(0.1, 0.1, 0), b(0.9, 0.2, 0), c(0.3, 0.8, 0);
+    const glm::dvec3 centre = (a + b + c) / 3.0;
+    const glm::dvec3 points[3] = {(4.0 * a + b + c) / 6.0, (a + 4.0 * b + c) / 6.0,
+                                  (a + b + 4.0 * c) / 6.0};
+    std::vector<std::array<glm::dvec3, 3>> faces;  // the other five faces, two triangles each
+    const auto quad = [&](glm::dvec3 p, glm::dvec3 q, glm::dvec3 r, glm::dvec3 s) {
+        faces.push_back({p, q, r});
+        faces.push_back({p, r, s});
+    };
+    quad({0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1});
+    quad({0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1});
+    quad({0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1});
+    quad({0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1});
+    quad({1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1});
+    double sum = 0.0;
+    for (const auto& [p, q, r] : faces) {
+        const SidedFormFactor f = MeanPointToTriangle(centre, points, 3, n, p, q, r);
+        double oneByOne = 0.0;
+        for (const glm::dvec3& x : points) oneByOne += PointToTriangle(x, n, p, q, r).upper / 3.0;
+        EXPECT_NEAR(f.upper, oneByOne, 1e-12);
+        EXPECT_EQ(f.lower, 0.0);
+        EXPECT_NEAR(f.solidAngleSr, PointToTriangle(centre, n, p, q, r).solidAngleSr, 1e-12);
+        sum += f.upper;
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-9);
 }
 
 // Hierarchical radiosity does not make form factors sum to one exactly; an excess δ comes

@@ -19,4 +19,11 @@ struct SidedFormFactor {
 SidedFormFactor PointToTriangle(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3& a,
                                 const glm::dvec3& b, const glm::dvec3& c);
 
+// The form factors of each side averaged over points xs[0..count) of the plane through
+// `centre` of normal n (the triangle clipped by that plane once); the solid angle seen
+// from `centre`.
+SidedFormFactor MeanPointToTriangle(const glm::dvec3& centre, const glm::dvec3* xs, int count,
+                                    const glm::dvec3& n, const glm::dvec3& a, const glm::dvec3& b,
+                                    const glm::dvec3& c);
+
 }  // namespace leaflux

@@ -712,15 +712,23 @@ class HrcSolver {
         if (S.patch) {
             const glm::dvec3 centre = (S.a + S.b + S.c) / 3.0;
             e.senderSide = glm::dot(S.normal, R.centroid - centre) >= 0.0 ? kUpper : kLower;
-            // The solid angle at R's centroid, with the same second-order correction for
-            // the spread of R's area as between clusters.
-            const glm::dvec3 ra = glm::normalize(S.a - R.centroid),
-                             rb = glm::normalize(S.b - R.centroid),
-                             rc = glm::normalize(S.c - R.centroid);
-            const double square =
-                std::max(glm::dot(centre - R.centroid, centre - R.centroid), 1e-300);
-            const double spread = std::min(R.spread * R.spread / (3.0 * square), 1.0);
-            e.geometric = SphericalTriangleSolidAngle(ra, rb, rc) / kPi * (1.0 + spread);
+            // R is a cluster: S's solid angle averaged over R's children by area, each with
+            // the second-order correction for the spread of its own area that clusters get.
+            // Taken at R's centroid with R's spread, the correction overshot: on the dense
+            // canopy these links handed on 1.032 of what rays from their senders land (0.962
+            // uncorrected), over the children 1.016.
+            e.geometric = 0.0;
+            for (std::uint32_t child : R.children) {
+                const HrcNode& C = hierarchy_[child];
+                const glm::dvec3 ra = glm::normalize(S.a - C.centroid),
+                                 rb = glm::normalize(S.b - C.centroid),
+                                 rc = glm::normalize(S.c - C.centroid);
+                const double square =
+                    std::max(glm::dot(centre - C.centroid, centre - C.centroid), 1e-300);
+                const double spread = std::min(C.spread * C.spread / (3.0 * square), 1.0);
+                e.geometric += C.areaM2 / R.areaM2 * SphericalTriangleSolidAngle(ra, rb, rc) / kPi *
+                               (1.0 + spread);
+            }
             // The side of S facing R sends B A_S; the link hands B × geometric to each unit of
             // R's area facing S: no more than S sends, however near R's centroid is.
             const double facing = ProjectedArea(r, e.toSender);
@@ -766,13 +774,23 @@ class HrcSolver {
         return e;
     }
 
-    // Patch ← patch: Lambert's formula at the receiver's centre, per side.
+    // Patch ← patch: Lambert's formula per side, averaged over three points of R (the
+    // degree-2 rule, barycentric (2/3, 1/6, 1/6)); the solid angle at R's centre. F is convex
+    // in the distance, so its value at R's centre falls short of R's mean where S is near:
+    // on the dense canopy exact links handed on 0.967 of what rays from their senders land,
+    // with the three points 0.999, and its NIR balance at 1e-4 went from 1.87 to −0.48 %
+    // (0.02 % with EstimatePair's links from patches averaged over R's children).
+    // Every exact link into R takes the same points, so that in a closed room they still sum
+    // to one: three points for near links only lost 41 % of the closed box's light at
+    // ρ = 0.999, for all links the box keeps it within 0.5 %.
     Estimate EstimateExact(std::uint32_t r, std::uint32_t s) const {
         const HrcNode& R = hierarchy_[r];
         const HrcNode& S = hierarchy_[s];
         Estimate e;
         const glm::dvec3 x = (R.a + R.b + R.c) / 3.0, y = (S.a + S.b + S.c) / 3.0;
-        e.form = PointToTriangle(x, R.normal, S.a, S.b, S.c);
+        const glm::dvec3 points[3] = {(4.0 * R.a + R.b + R.c) / 6.0, (R.a + 4.0 * R.b + R.c) / 6.0,
+                                      (R.a + R.b + 4.0 * R.c) / 6.0};
+        e.form = MeanPointToTriangle(x, points, 3, R.normal, S.a, S.b, S.c);
         e.senderSide = glm::dot(S.normal, x - y) >= 0.0 ? kUpper : kLower;
         e.toSender = glm::normalize(y - x);
         if (S.areaM2 < R.areaM2 / 16.0) {

@@ -1,26 +1,28 @@
 // Hierarchical radiosity with clustering (`hrc`), the paper's baseline (Soler 2003 §3.1,
 // after Smits 1994 and Sillion 1995), with two-sided leaves (§4.3).
 //
-// Links join the nodes of a Hierarchy (clusters and patches) and the directional sources
-// (suns, sky cones) to nodes. A link between clusters carries light as a point transfer
-// I_S(ω) · v / d², the sender's intensity sampled on a tetrahedral direction set
-// (DirectionSet, §4.2.2) and the receiver's incoming light kept per direction, so that
-// clusters emit and receive as volumes with no assumption of flatness. A link between
-// two patches uses the analytic point-to-polygon form factor, bounded in the near field.
-// Visibility is the unoccluded fraction of deterministic stratified rays through Embree,
-// each ray weighted by the form factor's kernel.
+// Links join the nodes of a Hierarchy (clusters and patches) and the directional sources (suns, sky
+// cones) to nodes. A link between clusters carries light as a point transfer I_S(ω) · v / d², the
+// sender's intensity sampled on a tetrahedral direction set (DirectionSet, §4.2.2) and the
+// receiver's incoming light kept per direction, so that clusters emit and receive as volumes with
+// no assumption of flatness; a patch's cosine lobe, interpolated between the directions, is scaled
+// to integrate to π per side as the lobe does. A link between two patches uses the analytic
+// point-to-polygon form factor, bounded in the near field. Visibility is the unoccluded fraction of
+// deterministic stratified rays through Embree, each ray weighted by the form factor's kernel.
 //
 // Refinement: a link is split (the larger node, or a patch subdivided into four) while its
-// estimated error — the power it carries times its geometric error ((r_R + r_S)/d)² plus
-// its visibility spread 2√(v(1−v)), v the fraction of its rays that pass — exceeds ε times
-// the power the sources bring into the scene (less for links into clusters of organs,
-// HrcOptions::clusterTolerance); the candidate links are judged in parallel chunks and the
-// verdicts carried out in order, so the links do not depend on the number of threads. A link kept only because its rays agreed takes its transfer from rays of its own,
-// so that the choice of links does not bias the light they carry. Solution: Jacobi gathering with
-// push/pull (B₁ = ρ₁I₁ + τ₂→₁I₂, B₂ = ρ₂I₂ + τ₁→₂I₁; what is pulled up is the intensity of both
-// sides), accelerated by extrapolating the geometric series of the changes and iterated until the
-// change still to come is below the tolerance; between solutions every link is judged again with
-// the light found (refine–solve passes), so that senders dark when first linked are refined too.
+// estimated error — the power it carries times its geometric error ((r_R + r_S)/d)² plus its
+// visibility spread 2√(v(1−v)), v the fraction of its rays that pass — exceeds ε times the power
+// the sources bring into the scene (less for links into clusters of organs: from the suns and sky
+// cones ε / √(their number), from surfaces HrcOptions::clusterTolerance); the candidate links are
+// judged in parallel chunks and the verdicts carried out in order, so the links do not depend on
+// the number of threads. A link kept only because its rays agreed takes its transfer from rays of
+// its own, so that the choice of links does not bias the light they carry. Solution: Jacobi
+// gathering with push/pull (B₁ = ρ₁I₁ + τ₂→₁I₂, B₂ = ρ₂I₂ + τ₁→₂I₁; what is pulled up is the
+// intensity of both sides), accelerated by extrapolating the geometric series of the changes and
+// iterated until the change still to come is below the tolerance; between solutions every link is
+// judged again with the light found (refine–solve passes), so that senders dark when first linked
+// are refined too.
 #pragma once
 
 #include <cstdint>

@@ -1,8 +1,8 @@
 // leafluxd over loopback TCP: the protocol's own cost (Status round trips, a cycle with an
 // empty delta, answered with the last cycle's light — with the organs' results or none —
 // or solved again when it asks other outputs) and the latency of cycles of a plant growing to
-// 1,000 leaves (HRC, ε = 1e-4 and 3e-4) and 10,000 leaves (ε = 1e-4), one tenth of the plant
-// added per cycle.
+// 1,000 leaves (HRC, ε = 1e-4, 3e-4 and 1e-3) and 10,000 leaves (ε = 1e-4 and 3e-4), one
+// tenth of the plant added per cycle.
 // Run: build/release/tests/leaflux_bench_daemon [out.csv]
 #include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
@@ -106,7 +106,8 @@ int main(int argc, char** argv) {
         for (int i = 0; i < kCalls; ++i) daemon.Call(status);
         rows.push_back({"status", 0, 0.0, 0, 0, 1e3 * Seconds(start) / kCalls, 0.0});
     }
-    for (const auto& [leaves, epsilon] : {std::pair{1000, 1e-4}, {1000, 3e-4}, {10000, 1e-4}}) {
+    for (const auto& [leaves, epsilon] :
+         {std::pair{1000, 1e-4}, {1000, 3e-4}, {1000, 1e-3}, {10000, 1e-4}, {10000, 3e-4}}) {
         std::vector<v1::Node> nodes;
         v1::Request open;
         *open.mutable_open_session()->mutable_scene() = TreeScene(leaves, nodes);
