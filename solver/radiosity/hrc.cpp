@@ -782,7 +782,9 @@ class HrcSolver {
     // (0.02 % with EstimatePair's links from patches averaged over R's children).
     // Every exact link into R takes the same points, so that in a closed room they still sum
     // to one: three points for near links only lost 41 % of the closed box's light at
-    // ρ = 0.999, for all links the box keeps it within 0.5 %.
+    // ρ = 0.999, for all links the box keeps it within 0.5 %. Sixteen or 64 points (the
+    // converged mean) give 0.995 on the dense canopy and 1.06 on the seedling tray at
+    // ε = 1e-3, where three give 0.999 and 1.075: the tray's excess is not the rule's.
     Estimate EstimateExact(std::uint32_t r, std::uint32_t s) const {
         const HrcNode& R = hierarchy_[r];
         const HrcNode& S = hierarchy_[s];
