@@ -1,14 +1,15 @@
 // Hierarchical radiosity with clustering (`hrc`), the paper's baseline (Soler 2003 §3.1,
 // after Smits 1994 and Sillion 1995), with two-sided leaves (§4.3).
 //
-// Links join the nodes of a Hierarchy (clusters and patches) and the directional sources (suns, sky
-// cones) to nodes. A link between clusters carries light as a point transfer I_S(ω) · v / d², the
-// sender's intensity sampled on a tetrahedral direction set (DirectionSet, §4.2.2) and the
+// Links join the nodes of a Hierarchy (clusters and patches) and the directional sources (suns,
+// sky cones) to nodes. A link between clusters carries light as a point transfer I_S(ω) · v / d²,
+// the sender's intensity sampled on a tetrahedral direction set (DirectionSet, §4.2.2) and the
 // receiver's incoming light kept per direction, so that clusters emit and receive as volumes with
 // no assumption of flatness; a patch's cosine lobe, interpolated between the directions, is scaled
 // to integrate to π per side as the lobe does. A link between two patches uses the analytic
-// point-to-polygon form factor, bounded in the near field. Visibility is the unoccluded fraction of
-// deterministic stratified rays through Embree, each ray weighted by the form factor's kernel.
+// point-to-polygon form factor, bounded in the near field, averaged over three points of the
+// receiver. Visibility is the unoccluded fraction of deterministic stratified rays through Embree,
+// each ray weighted by the form factor's kernel.
 //
 // Refinement: a link is split (the larger node, or a patch subdivided into four) while its
 // estimated error — the power it carries times its geometric error ((r_R + r_S)/d)² plus its
