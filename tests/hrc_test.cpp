@@ -16,10 +16,15 @@ namespace leaflux {
 namespace {
 using namespace leaflux::testing;
 
-Solution SolveWithHrc(const PreparedScene& prepared, double epsilon, int subdivision = 3) {
+SolverSettings HrcSettings(double epsilon) {
     SolverSettings settings;
     settings.kind = SolverKind::kHrc;
     settings.hrc.epsilon = epsilon;
+    return settings;
+}
+
+Solution SolveWithHrc(const PreparedScene& prepared, double epsilon, int subdivision = 3) {
+    SolverSettings settings = HrcSettings(epsilon);
     settings.hrc.maxSubdivision = subdivision;
     return Solve(prepared, settings);
 }
@@ -127,9 +132,7 @@ TEST(HrcLamp, LightsAWallThatRisesAboveIt) {
             }
         }
     }
-    SolverSettings settings;
-    settings.kind = SolverKind::kHrc;
-    settings.hrc.epsilon = 1e-6;
+    SolverSettings settings = HrcSettings(1e-6);
     settings.hrc.directOnly = true;
     const PreparedScene prepared(scene);
     const Solution s = Solve(prepared, settings);
@@ -279,9 +282,7 @@ TEST(HrcTree, ErrorAgainstMonteCarloFallsWithEpsilon) {
 TEST(HrcTree, SameAnswerWhateverTheThreadCount) {
     const Scene scene = SmallTree({0.45, 0.45, 0.45, 0.45});
     const PreparedScene prepared(scene);
-    SolverSettings settings;
-    settings.kind = SolverKind::kHrc;
-    settings.hrc.epsilon = 1e-5;
+    SolverSettings settings = HrcSettings(1e-5);
     settings.hrc.threads = 1;
     const Solution one = Solve(prepared, settings);
     settings.hrc.threads = 2;
@@ -312,9 +313,7 @@ TEST(HrcTree, StiffLeavesGiveAFiniteConvergedAnswer) {
 TEST(HrcTree, LinkAuditLandsAllTheLightThatDoesNotEscape) {
     const Scene scene = SmallTree({0.45, 0.45, 0.45, 0.45});
     const PreparedScene prepared(scene);
-    SolverSettings settings;
-    settings.kind = SolverKind::kHrc;
-    settings.hrc.epsilon = 1e-4;
+    SolverSettings settings = HrcSettings(1e-4);
     settings.hrc.auditLinks = true;
     const Solution hrc = Solve(prepared, settings);
     ASSERT_EQ(hrc.linkAudit.size(), 3u);
@@ -375,9 +374,7 @@ TEST(HrcSky, LinksIntoClustersOfLeavesAreHeldToEpsilonOverRootOfSources) {
     scene.sources.suns.clear();
     const PreparedScene prepared(scene);
     const auto direct = [&](double epsilon) {
-        SolverSettings settings;
-        settings.kind = SolverKind::kHrc;
-        settings.hrc.epsilon = epsilon;
+        SolverSettings settings = HrcSettings(epsilon);
         settings.hrc.directOnly = true;
         return Solve(prepared, settings);
     };
