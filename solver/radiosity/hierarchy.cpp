@@ -87,7 +87,10 @@ std::uint32_t Hierarchy::AddPatch(std::uint32_t triangle) {
     node.triangle = triangle;
     node.receiver = t.receiver;
     nodes_.push_back(node);
-    return static_cast<std::uint32_t>(nodes_.size() - 1);
+    const auto index = static_cast<std::uint32_t>(nodes_.size() - 1);
+    if (patchOf_.empty()) patchOf_.assign(flat_.triangles.size(), kNoNode);
+    patchOf_[triangle] = index;
+    return index;
 }
 
 std::uint32_t Hierarchy::AddCluster(std::vector<std::uint32_t> children) {

@@ -62,6 +62,10 @@ class Hierarchy {
     };
     Point Sample(std::uint32_t node, double u, double v) const;
 
+    // The patch a flat triangle was made (before any subdivision), or kNoNode: its radiosity
+    // is the mean of its parts'.
+    std::uint32_t PatchOf(std::uint32_t triangle) const { return patchOf_[triangle]; }
+
     // Whether the point x of flat triangle `triangle` lies on the node's surfaces.
     bool Covers(std::uint32_t node, std::uint32_t triangle, const glm::dvec3& x) const;
 
@@ -77,6 +81,7 @@ class Hierarchy {
     std::vector<std::uint32_t> triangleOrder_;  // flat triangles in hierarchy order
     std::vector<double> cumulativeArea_;        // over triangleOrder_, starting at 0
     std::vector<std::uint32_t> orderOf_;        // by flat triangle: its place in triangleOrder_
+    std::vector<std::uint32_t> patchOf_;        // by flat triangle: PatchOf
     std::uint32_t root_ = kNoNode;
 };
 

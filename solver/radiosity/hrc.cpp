@@ -208,11 +208,6 @@ class HrcSolver {
         FindOrgans();
         FindInnerSides(scene);
         ScaleLobes();
-        patchOf_.assign(flat_.triangles.size(), kNoNode);
-        for (std::uint32_t n = 0; n < hierarchy_.Size(); ++n) {
-            if (hierarchy_[n].patch && hierarchy_[n].depth == 0)
-                patchOf_[hierarchy_[n].triangle] = n;
-        }
         for (const Sun& sun : scene.sources.suns) AddSource(sun.towardSun, sun.normalIrradianceWm2);
         for (const Sky& sky : scene.sources.skies) {
             Sky discrete = sky;
@@ -418,7 +413,7 @@ class HrcSolver {
                                   (distance * distance * distance);
             if (weight <= 0.0) continue;
             const double light =
-                fromCluster ? weight * SideRadiosity(patchOf_[q.triangle],
+                fromCluster ? weight * SideRadiosity(hierarchy_.PatchOf(q.triangle),
                                                      glm::dot(q.normal, d) < 0.0 ? kUpper : kLower)
                             : 0.0;
             ++rays, ++traced;
@@ -1094,9 +1089,6 @@ class HrcSolver {
     std::vector<SideOptics> optics_;
     std::vector<std::uint8_t> inner_;  // by flat triangle: bit s set when side s is inside
     std::vector<std::array<double, 2>> lobeScale_;  // by flat triangle and side: BinCosine
-    // By flat triangle: its patch as built (before subdivision), whose radiosity is the mean
-    // of its parts'.
-    std::vector<std::uint32_t> patchOf_;
     std::vector<std::uint8_t> organs_;  // by node of the hierarchy as built: 1 over an organ
     std::vector<DirectionalSource> sources_;
     double totalPower_ = 0.0;
@@ -1619,7 +1611,7 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
 template <int kBands>
 void HrcSolver<kBands>::AuditLinks(Solution& solution) const {
     // The radiosity at a point a sender's ray leaves from: its patch's, or for a cluster the
-    // flat triangle's (patchOf_).
+    // flat triangle's (Hierarchy::PatchOf).
     enum Kind { kExact, kFromPatch, kFromCluster, kKinds };
     struct Sum {
         std::int64_t links = 0;
@@ -1671,7 +1663,7 @@ void HrcSolver<kBands>::AuditLinks(Solution& solution) const {
                     // Both sides of S send: 2 A_S B over the rays of both.
                     const double w =
                         2.0 * S.areaM2 *
-                        SideRadiosity(S.patch ? link.sender : patchOf_[p.triangle], side);
+                        SideRadiosity(S.patch ? link.sender : hierarchy_.PatchOf(p.triangle), side);
                     shot += w;
                     square += w * w;
                 }
