@@ -75,8 +75,12 @@ Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat) : flat_(flat) {
     cumulativeArea_.push_back(0.0);
     Finish(root_);
     orderOf_.assign(flat.triangles.size(), 0);
-    for (std::size_t i = 0; i < triangleOrder_.size(); ++i)
+    ordered_.reserve(triangleOrder_.size());
+    for (std::size_t i = 0; i < triangleOrder_.size(); ++i) {
         orderOf_[triangleOrder_[i]] = static_cast<std::uint32_t>(i);
+        const Triangle& t = flat.triangles[triangleOrder_[i]];
+        ordered_.push_back({t.a, t.b, t.c, t.normal});
+    }
 }
 
 std::uint32_t Hierarchy::AddPatch(std::uint32_t triangle) {
@@ -247,26 +251,22 @@ bool Hierarchy::Subdivide(std::uint32_t index, double minAreaM2) {
 
 Hierarchy::Point Hierarchy::Sample(std::uint32_t index, double u, double v) const {
     const HrcNode& node = nodes_[index];
-    glm::dvec3 a = node.a, b = node.b, c = node.c;
-    std::uint32_t triangle = node.triangle;
-    if (!node.patch) {
-        // An original triangle by area, then a point inside it.
-        const double lo = cumulativeArea_[node.first],
-                     hi = cumulativeArea_[node.first + node.count];
-        const double target = lo + u * (hi - lo);
-        auto it = std::upper_bound(cumulativeArea_.begin() + node.first + 1,
-                                   cumulativeArea_.begin() + node.first + node.count + 1, target);
-        if (it == cumulativeArea_.begin() + node.first + node.count + 1) --it;
-        const std::size_t k = static_cast<std::size_t>(it - cumulativeArea_.begin()) - 1;
-        u = std::clamp(
-            (target - cumulativeArea_[k]) / (cumulativeArea_[k + 1] - cumulativeArea_[k]), 0.0,
-            1.0);
-        triangle = triangleOrder_[k];
-        const Triangle& t = flat_.triangles[triangle];
-        a = t.a, b = t.b, c = t.c;
+    if (node.patch) {
+        const glm::dvec3 w = UniformTriangle(u, v);
+        return {w.x * node.a + w.y * node.b + w.z * node.c, node.normal, node.triangle};
     }
+    // An original triangle by area, then a point inside it.
+    const double lo = cumulativeArea_[node.first], hi = cumulativeArea_[node.first + node.count];
+    const double target = lo + u * (hi - lo);
+    auto it = std::upper_bound(cumulativeArea_.begin() + node.first + 1,
+                               cumulativeArea_.begin() + node.first + node.count + 1, target);
+    if (it == cumulativeArea_.begin() + node.first + node.count + 1) --it;
+    const std::size_t k = static_cast<std::size_t>(it - cumulativeArea_.begin()) - 1;
+    u = std::clamp((target - cumulativeArea_[k]) / (cumulativeArea_[k + 1] - cumulativeArea_[k]),
+                   0.0, 1.0);
+    const Corners& t = ordered_[k];
     const glm::dvec3 w = UniformTriangle(u, v);
-    return {w.x * a + w.y * b + w.z * c, flat_.triangles[triangle].normal, triangle};
+    return {w.x * t.a + w.y * t.b + w.z * t.c, t.normal, triangleOrder_[k]};
 }
 
 bool Hierarchy::Covers(std::uint32_t index, std::uint32_t triangle, const glm::dvec3& x) const {

@@ -80,8 +80,14 @@ class Hierarchy {
     std::vector<HrcNode> nodes_;
     std::vector<std::uint32_t> triangleOrder_;  // flat triangles in hierarchy order
     std::vector<double> cumulativeArea_;        // over triangleOrder_, starting at 0
-    std::vector<std::uint32_t> orderOf_;        // by flat triangle: its place in triangleOrder_
-    std::vector<std::uint32_t> patchOf_;        // by flat triangle: PatchOf
+    // Their corners and normals in that order, so that sampling a cluster reads contiguous
+    // memory rather than the flat scene's triangles scattered.
+    struct Corners {
+        glm::dvec3 a, b, c, normal;
+    };
+    std::vector<Corners> ordered_;
+    std::vector<std::uint32_t> orderOf_;  // by flat triangle: its place in triangleOrder_
+    std::vector<std::uint32_t> patchOf_;  // by flat triangle: PatchOf
     std::uint32_t root_ = kNoNode;
 };
 
