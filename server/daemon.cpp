@@ -131,13 +131,14 @@ v1::Reply ErrorReply(v1::ErrorCode code, const std::string& message, const std::
 }
 
 Session::Session(Scene scene, MeshLibrary meshes, SolverSettings settings)
-    : scene_(std::move(scene)), meshes_(std::move(meshes)), settings_(std::move(settings)) {
+    : store_(std::move(scene)), meshes_(std::move(meshes)), settings_(std::move(settings)) {
     Count();
 }
 
 void Session::Count() {
-    nodes_ = static_cast<int>(scene_.nodes.size());
-    organs_ = static_cast<int>(std::count_if(scene_.nodes.begin(), scene_.nodes.end(),
+    const Scene& scene = store_.Get();
+    nodes_ = static_cast<int>(scene.nodes.size());
+    organs_ = static_cast<int>(std::count_if(scene.nodes.begin(), scene.nodes.end(),
                                              [](const Node& n) { return n.organ.has_value(); }));
 }
 
@@ -156,11 +157,16 @@ v1::CycleResult Session::Run(const v1::Cycle& cycle) {
         return result;
     }
     const Clock::time_point start = Clock::now();
-    Scene next = Next(cycle);
+    store_.Apply(Change(cycle));  // validated whole, before anything is kept
     spdlog::debug("cycle {}: delta applied and the scene validated in {:.1f} ms", cycle.number(),
                   Milliseconds(start));
-    v1::CycleResult result = Solve(next, cycle.outputs());
-    scene_ = std::move(next);
+    v1::CycleResult result;
+    try {
+        result = Solve(cycle.outputs());
+    } catch (...) {
+        store_.Undo();
+        throw;
+    }
     Count();
     ++cycles_;
     last_ = result;
@@ -168,54 +174,24 @@ v1::CycleResult Session::Run(const v1::Cycle& cycle) {
     return result;
 }
 
-Scene Session::Next(const v1::Cycle& cycle) const {
-    Scene next = scene_;
+SceneChange Session::Change(const v1::Cycle& cycle) const {
     const v1::TopologyDelta& delta = cycle.delta();
-    std::unordered_map<NodeId, std::size_t> at;
-    for (std::size_t i = 0; i < next.nodes.size(); ++i) at[next.nodes[i].id] = i;
-    // Removals take their whole subtree.
-    std::set<NodeId> removed;
-    for (std::uint64_t id : delta.removed()) {
-        if (!at.count(id))
-            throw InputError(ErrorCode::kNotFound, "delta.removed", "no such node", id);
-        removed.insert(id);
-    }
-    for (bool grew = true; grew;) {
-        grew = false;
-        for (const Node& node : next.nodes) {
-            if (node.parent != kNoParent && removed.count(node.parent) &&
-                removed.insert(node.id).second)
-                grew = true;
-        }
-    }
-    for (const v1::Node& in : delta.updated()) {
-        const auto it = at.find(in.id());
-        if (it == at.end() || removed.count(in.id())) {
-            throw InputError(ErrorCode::kNotFound, "delta.updated", "no such node to update",
-                             in.id());
-        }
-        next.nodes[it->second] = NodeFromProto(in, meshes_);
-    }
-    std::erase_if(next.nodes, [&](const Node& node) { return removed.count(node.id) > 0; });
-    for (const v1::Node& in : delta.added()) {
-        if (at.count(in.id()) && !removed.count(in.id())) {
-            throw InputError(ErrorCode::kAlreadyExists, "delta.added", "a node with this id exists",
-                             in.id());
-        }
-        next.nodes.push_back(NodeFromProto(in, meshes_));
-    }
+    SceneChange change;
+    change.removed.assign(delta.removed().begin(), delta.removed().end());
+    for (const v1::Node& in : delta.updated()) change.updated.push_back(NodeFromProto(in, meshes_));
+    for (const v1::Node& in : delta.added()) change.added.push_back(NodeFromProto(in, meshes_));
     if (cycle.suns_size() > 0) {
-        next.sources.suns.clear();
+        change.suns.emplace();
         for (int i = 0; i < cycle.suns_size(); ++i) {
-            next.sources.suns.push_back(
-                SunFromProto(next, cycle.suns(i), "suns[" + std::to_string(i) + "]"));
+            change.suns->push_back(
+                SunFromProto(store_.Get(), cycle.suns(i), "suns[" + std::to_string(i) + "]"));
         }
     }
-    next.Validate();  // whole, before anything is kept
-    return next;
+    return change;
 }
 
-v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outputs) const {
+v1::CycleResult Session::Solve(const v1::OutputRequest& outputs) const {
+    const Scene& scene = store_.Get();
     std::vector<int> wanted;
     for (const std::string& band : outputs.bands()) {
         const int b = scene.BandIndex(band);
@@ -242,7 +218,7 @@ v1::CycleResult Session::Solve(const Scene& scene, const v1::OutputRequest& outp
     SolverSettings settings = settings_;
     settings.hrc.lightVectors = lightVectors;
     Clock::time_point start = Clock::now();
-    const PreparedScene prepared(solved);
+    const PreparedScene prepared(solved, store_.Flat());  // the bands do not change the geometry
     spdlog::debug("scene flattened and its ray engine built in {:.1f} ms", Milliseconds(start));
     start = Clock::now();
     const Solution solution = leaflux::Solve(prepared, settings);

@@ -2,8 +2,8 @@
 //
 // Every request is decoded, dispatched by type to one handler and answered with a Reply;
 // each handler runs inside one try/catch, so a bad request gets a typed Error and never
-// takes the daemon down. A session changes only when a request succeeds: deltas are applied
-// to a copy of its scene, validated whole, then swapped in.
+// takes the daemon down. A session changes only when a request succeeds: a delta is checked
+// whole before it is applied, and taken back if its solve fails.
 #pragma once
 
 #include <atomic>
@@ -17,6 +17,7 @@
 
 #include "leaflux.pb.h"
 #include "server/scene_proto.h"
+#include "solver/scene_store.h"
 #include "solver/solve.h"
 
 namespace leaflux {
@@ -26,9 +27,10 @@ class Session {
   public:
     Session(Scene scene, MeshLibrary meshes, SolverSettings settings);
 
-    // Applies a cycle's delta and suns to a copy of the scene, validates it whole, solves
-    // it for what the cycle's outputs ask, and only then keeps it. Throws InputError
-    // (naming the field or node) and leaves the session as it was otherwise. A cycle that
+    // Checks a cycle's delta and suns against the scene they make, applies them and solves
+    // that scene for what the cycle's outputs ask; the checks and the geometry cost what
+    // the delta touches (SceneStore). Throws InputError (naming the field or node), and
+    // then the session is as it was: a delta whose solve fails is taken back. A cycle that
     // changes nothing and asks what the last one asked gets the last one's light again.
     v1::CycleResult Run(const v1::Cycle& cycle);
 
@@ -38,12 +40,12 @@ class Session {
     int Organs() const { return organs_; }
 
   private:
-    Scene Next(const v1::Cycle& cycle) const;
-    v1::CycleResult Solve(const Scene& scene, const v1::OutputRequest& outputs) const;
+    SceneChange Change(const v1::Cycle& cycle) const;
+    v1::CycleResult Solve(const v1::OutputRequest& outputs) const;
 
     void Count();
 
-    Scene scene_;
+    SceneStore store_;
     MeshLibrary meshes_;
     SolverSettings settings_;
     // The last cycle's result and the outputs it answered (serialised), for a cycle that

@@ -4,18 +4,11 @@
 
 namespace leaflux {
 namespace {
-void AddMesh(const Mesh& mesh, const glm::dmat4& worldFromLocal, Receiver receiver,
-             std::vector<Triangle>& worldTriangles, FlatScene& flat) {
+void AddReceiver(const std::vector<Triangle>& placed, Receiver receiver,
+                 std::vector<Triangle>& worldTriangles, FlatScene& flat) {
     receiver.firstTriangle = static_cast<std::uint32_t>(worldTriangles.size());
     const auto receiverIndex = static_cast<std::uint32_t>(flat.receivers.size());
-    for (const glm::uvec3& tri : mesh.triangles) {
-        Triangle t;
-        t.a = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.x], 1.0));
-        t.b = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.y], 1.0));
-        t.c = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.z], 1.0));
-        const glm::dvec3 cross = glm::cross(t.b - t.a, t.c - t.a);
-        t.areaM2 = 0.5 * glm::length(cross);
-        t.normal = cross / (2.0 * t.areaM2);
+    for (Triangle t : placed) {
         t.receiver = receiverIndex;
         receiver.areaM2 += t.areaM2;
         worldTriangles.push_back(t);
@@ -26,27 +19,54 @@ void AddMesh(const Mesh& mesh, const glm::dmat4& worldFromLocal, Receiver receiv
 }
 }  // namespace
 
+std::vector<Triangle> PlaceMesh(const Mesh& mesh, const glm::dmat4& worldFromLocal) {
+    std::vector<Triangle> placed;
+    placed.reserve(mesh.triangles.size());
+    for (const glm::uvec3& tri : mesh.triangles) {
+        Triangle t;
+        t.a = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.x], 1.0));
+        t.b = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.y], 1.0));
+        t.c = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.z], 1.0));
+        const glm::dvec3 cross = glm::cross(t.b - t.a, t.c - t.a);
+        t.areaM2 = 0.5 * glm::length(cross);
+        t.normal = cross / (2.0 * t.areaM2);
+        t.receiver = 0;
+        placed.push_back(t);
+    }
+    return placed;
+}
+
 FlatScene Flatten(const Scene& scene) {
+    const auto worldFromLocal = WorldFromLocal(scene);
+    std::vector<Triangle> placed;
+    return Flatten(scene, [&](const Node& organ) -> const std::vector<Triangle>& {
+        placed = PlaceMesh(*organ.organ->mesh, worldFromLocal.at(organ.id));
+        return placed;
+    });
+}
+
+FlatScene Flatten(const Scene& scene, const PlacedOrgans& placed) {
     FlatScene flat;
     std::vector<Triangle> triangles;
-    const auto worldFromLocal = WorldFromLocal(scene);
     for (const Node& node : scene.nodes) {
         if (!node.organ) continue;
         Receiver receiver{scene.NodeName(node), ReceiverKind::kOrgan, node.id,
                           scene.OpticsIndex(node.organ->opticsId)};
-        AddMesh(*node.organ->mesh, worldFromLocal.at(node.id), receiver, triangles, flat);
+        AddReceiver(placed(node), std::move(receiver), triangles, flat);
     }
     for (const Surface& surface : scene.environment) {
         Receiver receiver{surface.name, ReceiverKind::kEnvironment, 0,
                           scene.OpticsIndex(surface.opticsId)};
-        AddMesh(*surface.mesh, glm::dmat4(1.0), receiver, triangles, flat);
+        AddReceiver(PlaceMesh(*surface.mesh, glm::dmat4(1.0)), std::move(receiver), triangles,
+                    flat);
     }
     for (std::size_t e = 0; e < scene.sources.emitters.size(); ++e) {
         const Emitter& emitter = scene.sources.emitters[e];
         Receiver receiver{emitter.name, ReceiverKind::kEmitter, 0,
                           emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId),
                           static_cast<int>(e)};
-        AddMesh(*emitter.mesh, glm::dmat4(1.0), receiver, triangles, flat);
+        AddReceiver(PlaceMesh(*emitter.mesh, glm::dmat4(1.0)), std::move(receiver), triangles,
+                    flat);
     }
     if (triangles.empty()) return flat;
 

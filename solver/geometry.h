@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <glm/glm.hpp>
 #include <optional>
 #include <string>
@@ -49,5 +50,12 @@ struct FlatScene {
 
 // Flattens a validated scene. Receivers come in scene order: organs, environment, emitters.
 FlatScene Flatten(const Scene& scene);
+
+// A mesh's triangles placed by worldFromLocal, in world coordinates (receiver 0).
+std::vector<Triangle> PlaceMesh(const Mesh& mesh, const glm::dmat4& worldFromLocal);
+// Flatten, with each organ's triangles as PlaceMesh placed them by its world frame (kept
+// from an earlier cycle by a SceneStore); the result is the same.
+using PlacedOrgans = std::function<const std::vector<Triangle>&(const Node& organ)>;
+FlatScene Flatten(const Scene& scene, const PlacedOrgans& placed);
 
 }  // namespace leaflux

@@ -40,6 +40,103 @@ void RequirePerBand(const Scene& scene, const std::vector<double>& values,
     }
 }
 
+void ValidateOptics(const Scene& scene) {
+    std::set<std::string> ids;
+    for (const Optics& optics : scene.optics) {
+        const std::string field = "optics[" + optics.id + "]";
+        Require(!optics.id.empty(), ErrorCode::kInvalidArgument, "optics.id", "is empty");
+        Require(ids.insert(optics.id).second, ErrorCode::kAlreadyExists, field,
+                "is declared twice");
+        Require(
+            optics.bands.size() == scene.bands.size(), ErrorCode::kNotFound, field + ".bands",
+            "needs properties for each of the " + std::to_string(scene.bands.size()) + " bands");
+        for (std::size_t b = 0; b < optics.bands.size(); ++b) {
+            const BandOptics& o = optics.bands[b];
+            const std::string at = field + ".bands[" + scene.bands[b].name + "]";
+            RequireFraction(o.rhoUpper, at + ".rho_upper");
+            RequireFraction(o.rhoLower, at + ".rho_lower");
+            RequireFraction(o.tauUpperToLower, at + ".tau_upper");
+            RequireFraction(o.tauLowerToUpper, at + ".tau_lower");
+            Require(o.rhoUpper + o.tauUpperToLower <= 1.0, ErrorCode::kInvalidArgument, at,
+                    "rho_upper + tau_upper exceeds 1: the upper side would create light");
+            Require(o.rhoLower + o.tauLowerToUpper <= 1.0, ErrorCode::kInvalidArgument, at,
+                    "rho_lower + tau_lower exceeds 1: the lower side would create light");
+        }
+    }
+}
+
+void RequireOptics(const Scene& scene, const std::string& id, const std::string& field,
+                   std::optional<NodeId> node) {
+    if (scene.OpticsIndex(id) < 0)
+        throw InputError(ErrorCode::kNotFound, field, "names unknown optics '" + id + "'", node);
+}
+
+void ValidateTopology(const Scene& scene, std::set<std::string>& names) {
+    std::unordered_map<NodeId, const Node*> byId;
+    byId.reserve(scene.nodes.size());
+    for (const Node& node : scene.nodes) {
+        if (!byId.emplace(node.id, &node).second) {
+            throw InputError(ErrorCode::kAlreadyExists, "nodes.id", "the id is used by two nodes",
+                             node.id);
+        }
+    }
+    for (const Node& node : scene.nodes) {
+        ValidateNode(scene, node);
+        if (node.parent != kNoParent && !byId.count(node.parent)) {
+            throw InputError(ErrorCode::kNotFound, "parent",
+                             "names unknown node " + std::to_string(node.parent), node.id);
+        }
+    }
+    // Cycles: walk up from each node; a walk longer than the node count loops.
+    std::unordered_set<NodeId> rooted;
+    for (const Node& node : scene.nodes) {
+        std::vector<NodeId> path;
+        NodeId at = node.id;
+        while (at != kNoParent && !rooted.count(at)) {
+            path.push_back(at);
+            if (path.size() > scene.nodes.size()) {
+                throw InputError(ErrorCode::kCycle, "parent", "the parent links of this node loop",
+                                 node.id);
+            }
+            at = byId.at(at)->parent;
+        }
+        rooted.insert(path.begin(), path.end());
+    }
+    const auto worldFromLocal = WorldFromLocal(scene);
+    for (const Node& node : scene.nodes) {
+        if (!node.organ) continue;
+        ValidateMesh(node.organ->mesh.get(), worldFromLocal.at(node.id), "organ.mesh", node.id);
+        std::string name = scene.NodeName(node);
+        if (!names.insert(name).second) {
+            throw InputError(ErrorCode::kAlreadyExists, "name",
+                             "organ name '" + name + "' is used twice", node.id);
+        }
+    }
+}
+
+void ValidateSources(const Scene& scene, std::set<std::string>& names) {
+    for (std::size_t i = 0; i < scene.sources.suns.size(); ++i) {
+        ValidateSun(scene, scene.sources.suns[i], "suns[" + std::to_string(i) + "]");
+    }
+    for (const Sky& sky : scene.sources.skies) {
+        RequirePerBand(scene, sky.horizontalIrradianceWm2, "sky.horizontal_irradiance");
+    }
+    for (std::size_t i = 0; i < scene.sources.emitters.size(); ++i) {
+        const Emitter& emitter = scene.sources.emitters[i];
+        const std::string field = "emitters[" + emitter.name + "]";
+        Require(!emitter.name.empty(), ErrorCode::kInvalidArgument,
+                "emitters[" + std::to_string(i) + "].name", "is empty");
+        ValidateMesh(emitter.mesh.get(), glm::dmat4(1.0), field + ".mesh", std::nullopt);
+        RequirePerBand(scene, emitter.exitanceWm2, field + ".exitance");
+        if (!emitter.opticsId.empty())
+            RequireOptics(scene, emitter.opticsId, field + ".optics", {});
+        Require(names.insert(emitter.name).second, ErrorCode::kAlreadyExists, field + ".name",
+                "the name is used twice");
+    }
+}
+
+}  // namespace
+
 // A triangle is degenerate when its area vanishes against its edges: the sine of its
 // largest angle's complement is below 1e-9 (a sliver Embree would lose in float).
 void ValidateMesh(const Mesh* mesh, const glm::dmat4& worldFromLocal, const std::string& field,
@@ -79,129 +176,37 @@ void ValidateMesh(const Mesh* mesh, const glm::dmat4& worldFromLocal, const std:
     }
 }
 
-void ValidateOptics(const Scene& scene) {
-    std::set<std::string> ids;
-    for (const Optics& optics : scene.optics) {
-        const std::string field = "optics[" + optics.id + "]";
-        Require(!optics.id.empty(), ErrorCode::kInvalidArgument, "optics.id", "is empty");
-        Require(ids.insert(optics.id).second, ErrorCode::kAlreadyExists, field,
-                "is declared twice");
-        Require(
-            optics.bands.size() == scene.bands.size(), ErrorCode::kNotFound, field + ".bands",
-            "needs properties for each of the " + std::to_string(scene.bands.size()) + " bands");
-        for (std::size_t b = 0; b < optics.bands.size(); ++b) {
-            const BandOptics& o = optics.bands[b];
-            const std::string at = field + ".bands[" + scene.bands[b].name + "]";
-            RequireFraction(o.rhoUpper, at + ".rho_upper");
-            RequireFraction(o.rhoLower, at + ".rho_lower");
-            RequireFraction(o.tauUpperToLower, at + ".tau_upper");
-            RequireFraction(o.tauLowerToUpper, at + ".tau_lower");
-            Require(o.rhoUpper + o.tauUpperToLower <= 1.0, ErrorCode::kInvalidArgument, at,
-                    "rho_upper + tau_upper exceeds 1: the upper side would create light");
-            Require(o.rhoLower + o.tauLowerToUpper <= 1.0, ErrorCode::kInvalidArgument, at,
-                    "rho_lower + tau_lower exceeds 1: the lower side would create light");
+void ValidateNode(const Scene& scene, const Node& node) {
+    if (node.id == 0)
+        throw InputError(ErrorCode::kInvalidArgument, "nodes.id", "0 is not a valid id");
+    for (int c = 0; c < 4; ++c) {
+        for (int r = 0; r < 4; ++r) {
+            if (!std::isfinite(node.parentFromLocal[c][r]))
+                throw InputError(ErrorCode::kInvalidArgument, "frame", "is not finite", node.id);
         }
     }
+    if (!(std::abs(glm::determinant(glm::dmat3(node.parentFromLocal))) > 1e-30))
+        throw InputError(ErrorCode::kDegenerate, "frame", "is singular", node.id);
+    if (!std::isfinite(node.age))
+        throw InputError(ErrorCode::kInvalidArgument, "age", "is not finite", node.id);
+    for (const auto& [key, value] : node.attributes) {
+        if (!std::isfinite(value)) {
+            throw InputError(ErrorCode::kInvalidArgument, "attributes[" + key + "]",
+                             "is not finite", node.id);
+        }
+    }
+    if (node.organ) RequireOptics(scene, node.organ->opticsId, "organ.optics", node.id);
 }
 
-void RequireOptics(const Scene& scene, const std::string& id, const std::string& field,
-                   std::optional<NodeId> node) {
-    if (scene.OpticsIndex(id) < 0)
-        throw InputError(ErrorCode::kNotFound, field, "names unknown optics '" + id + "'", node);
+void ValidateSun(const Scene& scene, const Sun& sun, const std::string& field) {
+    Require(Finite(sun.towardSun) && std::abs(glm::length(sun.towardSun) - 1.0) < 1e-6,
+            ErrorCode::kInvalidArgument, field + ".direction", "must be a finite unit vector");
+    RequirePerBand(scene, sun.normalIrradianceWm2, field + ".normal_irradiance");
+    Require(std::isfinite(sun.angularRadiusRad) && sun.angularRadiusRad >= 0.0 &&
+                sun.angularRadiusRad <= 0.2,
+            ErrorCode::kInvalidArgument, field + ".angular_radius_deg",
+            "must be between 0 and about 11 degrees");
 }
-
-void ValidateTopology(const Scene& scene, std::set<std::string>& names) {
-    std::unordered_map<NodeId, const Node*> byId;
-    byId.reserve(scene.nodes.size());
-    for (const Node& node : scene.nodes) {
-        if (node.id == 0)
-            throw InputError(ErrorCode::kInvalidArgument, "nodes.id", "0 is not a valid id");
-        if (!byId.emplace(node.id, &node).second) {
-            throw InputError(ErrorCode::kAlreadyExists, "nodes.id", "the id is used by two nodes",
-                             node.id);
-        }
-    }
-    for (const Node& node : scene.nodes) {
-        if (node.parent != kNoParent && !byId.count(node.parent)) {
-            throw InputError(ErrorCode::kNotFound, "parent",
-                             "names unknown node " + std::to_string(node.parent), node.id);
-        }
-        for (int c = 0; c < 4; ++c) {
-            for (int r = 0; r < 4; ++r) {
-                if (!std::isfinite(node.parentFromLocal[c][r]))
-                    throw InputError(ErrorCode::kInvalidArgument, "frame", "is not finite",
-                                     node.id);
-            }
-        }
-        if (!(std::abs(glm::determinant(glm::dmat3(node.parentFromLocal))) > 1e-30))
-            throw InputError(ErrorCode::kDegenerate, "frame", "is singular", node.id);
-        if (!std::isfinite(node.age))
-            throw InputError(ErrorCode::kInvalidArgument, "age", "is not finite", node.id);
-        for (const auto& [key, value] : node.attributes) {
-            if (!std::isfinite(value)) {
-                throw InputError(ErrorCode::kInvalidArgument, "attributes[" + key + "]",
-                                 "is not finite", node.id);
-            }
-        }
-    }
-    // Cycles: walk up from each node; a walk longer than the node count loops.
-    std::unordered_set<NodeId> rooted;
-    for (const Node& node : scene.nodes) {
-        std::vector<NodeId> path;
-        NodeId at = node.id;
-        while (at != kNoParent && !rooted.count(at)) {
-            path.push_back(at);
-            if (path.size() > scene.nodes.size()) {
-                throw InputError(ErrorCode::kCycle, "parent", "the parent links of this node loop",
-                                 node.id);
-            }
-            at = byId.at(at)->parent;
-        }
-        rooted.insert(path.begin(), path.end());
-    }
-    const auto worldFromLocal = WorldFromLocal(scene);
-    for (const Node& node : scene.nodes) {
-        if (!node.organ) continue;
-        RequireOptics(scene, node.organ->opticsId, "organ.optics", node.id);
-        ValidateMesh(node.organ->mesh.get(), worldFromLocal.at(node.id), "organ.mesh", node.id);
-        std::string name = scene.NodeName(node);
-        if (!names.insert(name).second) {
-            throw InputError(ErrorCode::kAlreadyExists, "name",
-                             "organ name '" + name + "' is used twice", node.id);
-        }
-    }
-}
-
-void ValidateSources(const Scene& scene, std::set<std::string>& names) {
-    for (std::size_t i = 0; i < scene.sources.suns.size(); ++i) {
-        const Sun& sun = scene.sources.suns[i];
-        const std::string field = "suns[" + std::to_string(i) + "]";
-        Require(Finite(sun.towardSun) && std::abs(glm::length(sun.towardSun) - 1.0) < 1e-6,
-                ErrorCode::kInvalidArgument, field + ".direction", "must be a finite unit vector");
-        RequirePerBand(scene, sun.normalIrradianceWm2, field + ".normal_irradiance");
-        Require(std::isfinite(sun.angularRadiusRad) && sun.angularRadiusRad >= 0.0 &&
-                    sun.angularRadiusRad <= 0.2,
-                ErrorCode::kInvalidArgument, field + ".angular_radius_deg",
-                "must be between 0 and about 11 degrees");
-    }
-    for (const Sky& sky : scene.sources.skies) {
-        RequirePerBand(scene, sky.horizontalIrradianceWm2, "sky.horizontal_irradiance");
-    }
-    for (std::size_t i = 0; i < scene.sources.emitters.size(); ++i) {
-        const Emitter& emitter = scene.sources.emitters[i];
-        const std::string field = "emitters[" + emitter.name + "]";
-        Require(!emitter.name.empty(), ErrorCode::kInvalidArgument,
-                "emitters[" + std::to_string(i) + "].name", "is empty");
-        ValidateMesh(emitter.mesh.get(), glm::dmat4(1.0), field + ".mesh", std::nullopt);
-        RequirePerBand(scene, emitter.exitanceWm2, field + ".exitance");
-        if (!emitter.opticsId.empty())
-            RequireOptics(scene, emitter.opticsId, field + ".optics", {});
-        Require(names.insert(emitter.name).second, ErrorCode::kAlreadyExists, field + ".name",
-                "the name is used twice");
-    }
-}
-
-}  // namespace
 
 const char* NodeTypeName(NodeType type) {
     switch (type) {

@@ -98,6 +98,14 @@ struct Scene {
     void Validate() const;
 };
 
+// Parts of Validate, for a store that checks only what a change touched (SceneStore).
+// One node alone: id, frame, age, attributes, organ optics (not its parent or mesh).
+void ValidateNode(const Scene& scene, const Node& node);
+// A mesh placed by worldFromLocal: finite positions, triangles of positive area.
+void ValidateMesh(const Mesh* mesh, const glm::dmat4& worldFromLocal, const std::string& field,
+                  std::optional<NodeId> node);
+void ValidateSun(const Scene& scene, const Sun& sun, const std::string& field);
+
 // The scene restricted to some of its bands, in the order given: optics, suns, skies and
 // emitters keep only those bands' values. A solver then does no work for the others.
 Scene WithBands(const Scene& scene, const std::vector<int>& bands);

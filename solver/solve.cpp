@@ -4,7 +4,10 @@
 
 namespace leaflux {
 
-PreparedScene::PreparedScene(const Scene& scene) : scene_(scene), flat_(Flatten(scene)) {
+PreparedScene::PreparedScene(const Scene& scene) : PreparedScene(scene, Flatten(scene)) {}
+
+PreparedScene::PreparedScene(const Scene& scene, FlatScene flat)
+    : scene_(scene), flat_(std::move(flat)) {
     std::optional<PeriodicDomain> periodic;
     if (scene.periodic) {
         // The ray engine works in the flat scene's frame, centred on its bounds.

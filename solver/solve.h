@@ -24,6 +24,8 @@ struct SolverSettings {
 class PreparedScene {
   public:
     explicit PreparedScene(const Scene& scene);  // scene must be valid and outlive this
+    // With the scene already flattened (SceneStore::Flat).
+    PreparedScene(const Scene& scene, FlatScene flat);
 
     const Scene& Source() const { return scene_; }
     const FlatScene& Flat() const { return flat_; }

@@ -584,6 +584,23 @@ TEST_F(DaemonOnLoopback, SessionsSolveInParallelAndADepartedClientDisturbsNoOne)
     EXPECT_EQ(Call(slowStatus).status().sessions(0).cycles(), 1);
 }
 
+// A delta that passes its checks but whose cycle fails later (here: its outputs name no
+// band) is taken back: the same delta, asked again with good outputs, is applied.
+TEST(DaemonCycles, ADeltaWhoseCycleFailsIsTakenBack) {
+    Daemon daemon;
+    const std::string session = daemon.Handle(OpenRequest()).opened().session();
+    v1::Request grow = CycleRequest(session, 1);
+    *grow.mutable_cycle()->mutable_delta()->add_added() = Leaf(7, 1, 0.5);
+    v1::Request badOutputs = grow;
+    badOutputs.mutable_cycle()->mutable_outputs()->add_bands("UV");
+    const v1::Reply failed = daemon.Handle(badOutputs);
+    ASSERT_TRUE(failed.has_error());
+    EXPECT_EQ(failed.error().code(), v1::ERROR_CODE_NOT_FOUND);
+    const v1::Reply grown = daemon.Handle(grow);
+    ASSERT_TRUE(grown.has_cycle()) << grown.DebugString();
+    EXPECT_EQ(grown.cycle().organs_size(), 2);
+}
+
 // A cycle that asks for one band gets that band alone, solved for it alone.
 // A cycle that changes nothing and asks what the last one asked gets the last one's light
 // again, without solving; other outputs, a delta or new suns are solved.

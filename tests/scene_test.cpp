@@ -2,12 +2,16 @@
 // or node, before anything reaches the ray engine.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
+#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 
 #include "solver/error.h"
+#include "solver/generator.h"
 #include "solver/geometry.h"
+#include "solver/scene_store.h"
 #include "tests/scene_builders.h"
 
 namespace leaflux {
@@ -268,6 +272,194 @@ TEST(Flatten, KeepsMillimetresFarFromTheOrigin) {
     // Local coordinates are centred: float precision is that of a 1 mm object.
     EXPECT_LT(glm::length(flat.triangles[0].a), 0.01);
     EXPECT_NEAR(flat.origin.x, 1e5, 1e-6);
+}
+
+// A 200-leaf generated tree (leaves on phytomers that carry no mesh) over a ground.
+Scene GrownTree() {
+    Scene scene = OneBandScene({{"leaf", Leaf(0.1, 0.05)}, {"stem", Opaque(0.3)}});
+    TreeParameters tree;
+    tree.leafCount = 200;
+    tree.seed = 5;
+    AddTree(scene, tree, {0, 0, 0});
+    scene.environment.push_back({"ground", Rectangle(4, 4, 0), "stem"});
+    scene.sources.suns.push_back(SunAt(45, 180, 1000));
+    return scene;
+}
+
+const Node& FindNode(const Scene& scene, std::function<bool(const Node&)> which) {
+    const auto it = std::find_if(scene.nodes.begin(), scene.nodes.end(), which);
+    if (it == scene.nodes.end()) throw std::logic_error("no such node in the test scene");
+    return *it;
+}
+
+void ExpectSameFlat(const FlatScene& kept, const FlatScene& fresh) {
+    EXPECT_EQ(kept.origin, fresh.origin);
+    EXPECT_EQ(kept.boundsMin, fresh.boundsMin);
+    EXPECT_EQ(kept.boundsMax, fresh.boundsMax);
+    ASSERT_EQ(kept.receivers.size(), fresh.receivers.size());
+    for (std::size_t r = 0; r < kept.receivers.size(); ++r) {
+        EXPECT_EQ(kept.receivers[r].name, fresh.receivers[r].name);
+        EXPECT_EQ(kept.receivers[r].node, fresh.receivers[r].node);
+        EXPECT_EQ(kept.receivers[r].areaM2, fresh.receivers[r].areaM2);
+        EXPECT_EQ(kept.receivers[r].firstTriangle, fresh.receivers[r].firstTriangle);
+    }
+    ASSERT_EQ(kept.triangles.size(), fresh.triangles.size());
+    for (std::size_t t = 0; t < kept.triangles.size(); ++t) {
+        const Triangle &a = kept.triangles[t], &b = fresh.triangles[t];
+        ASSERT_TRUE(a.a == b.a && a.b == b.b && a.c == b.c && a.normal == b.normal &&
+                    a.areaM2 == b.areaM2 && a.receiver == b.receiver)
+            << "triangle " << t;
+    }
+}
+
+// Cycle after cycle — a branch cut, a phytomer bent (moving the leaves above it), a leaf
+// given a new blade, leaves added, a new sun — the kept triangles flatten to what the
+// whole scene flattens to, bit for bit.
+TEST(SceneStore, FlattensAsTheWholeSceneAfterEachChange) {
+    const Scene start = GrownTree();
+    SceneStore store(start);
+    ExpectSameFlat(store.Flat(), Flatten(store.Get()));
+    const auto isAxis = [](const Node& n) {
+        return n.type == NodeType::kAxis && n.attributes.at("order") == 1.0;  // a branch
+    };
+    const auto isPhytomer = [](const Node& n) { return n.type == NodeType::kPhytomer; };
+    const auto isLeaf = [](const Node& n) { return n.type == NodeType::kLeaf; };
+
+    SceneChange cut;
+    cut.removed.push_back(FindNode(store.Get(), isAxis).id);
+    store.Apply(cut);
+    EXPECT_LT(store.Get().nodes.size(), start.nodes.size());
+    ExpectSameFlat(store.Flat(), Flatten(store.Get()));
+
+    SceneChange bend;
+    Node phytomer = FindNode(store.Get(), isPhytomer);
+    phytomer.parentFromLocal = glm::rotate(phytomer.parentFromLocal, 0.3, glm::dvec3(1, 0, 0));
+    bend.updated.push_back(phytomer);
+    Node leaf = FindNode(store.Get(), isLeaf);
+    leaf.organ->mesh = Rectangle(0.2, 0.1, 0.0);
+    bend.updated.push_back(leaf);
+    store.Apply(bend);
+    ExpectSameFlat(store.Flat(), Flatten(store.Get()));
+
+    SceneChange grow;
+    NodeId next = 0;
+    for (const Node& n : store.Get().nodes) next = std::max(next, n.id);
+    for (int k = 1; k <= 5; ++k) {
+        grow.added.push_back(OrganNode(next + k, "new" + std::to_string(k),
+                                       Rectangle(0.05, 0.03, 0.1 * k), "leaf", phytomer.id));
+    }
+    grow.suns = std::vector<Sun>{SunAt(30, 90, 800)};
+    store.Apply(grow);
+    ExpectSameFlat(store.Flat(), Flatten(store.Get()));
+    EXPECT_EQ(store.Get().sources.suns.at(0).normalIrradianceWm2, std::vector<double>{800.0});
+}
+
+// An organ the change leaves alone is still checked where the change moved it: shrinking
+// the phytomer under a leaf a billion times makes the leaf, not the phytomer, degenerate.
+// The store is then as it was.
+TEST(SceneStore, ChecksTheOrgansAChangeMoves) {
+    SceneStore store(GrownTree());
+    const Node& leaf =
+        FindNode(store.Get(), [](const Node& n) { return n.type == NodeType::kLeaf; });
+    Node phytomer = FindNode(store.Get(), [&](const Node& n) { return n.id == leaf.parent; });
+    ASSERT_FALSE(phytomer.organ.has_value());
+    phytomer.parentFromLocal = glm::scale(phytomer.parentFromLocal, glm::dvec3(1e-9));
+    SceneChange shrink;
+    shrink.updated.push_back(phytomer);
+    try {
+        store.Apply(shrink);
+        ADD_FAILURE() << "the shrunk leaf was not checked";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.Code(), ErrorCode::kDegenerate);
+        EXPECT_EQ(e.Node(), std::optional<std::uint64_t>(leaf.id));
+    }
+    ExpectSameFlat(store.Flat(), Flatten(GrownTree()));
+}
+
+// What whole validation finds in the scene a change makes, the store finds in the change:
+// a parent that does not exist or was removed, a loop, a name taken, an id used twice.
+TEST(SceneStore, RejectsWhatWholeValidationRejects) {
+    const Scene start = GrownTree();
+    SceneStore store(start);
+    const Node& leaf = FindNode(start, [](const Node& n) { return n.type == NodeType::kLeaf; });
+    const Node& axis = FindNode(start, [](const Node& n) { return n.type == NodeType::kAxis; });
+    const Node& branch = FindNode(
+        start, [&](const Node& n) { return n.type == NodeType::kAxis && n.id != axis.id; });
+    const auto expect = [&](SceneChange change, ErrorCode code, NodeId node) {
+        Scene whole = start;  // the same change, made to a copy and validated whole
+        std::erase_if(whole.nodes, [&](const Node& n) {
+            return std::count(change.removed.begin(), change.removed.end(), n.id) > 0;
+        });
+        for (const Node& u : change.updated) {
+            for (Node& n : whole.nodes) {
+                if (n.id == u.id) n = u;
+            }
+        }
+        whole.nodes.insert(whole.nodes.end(), change.added.begin(), change.added.end());
+        EXPECT_THROW(whole.Validate(), InputError);
+        try {
+            store.Apply(change);
+            ADD_FAILURE() << "accepted";
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.Code(), code) << e.what();
+            EXPECT_EQ(e.Node(), std::optional<std::uint64_t>(node)) << e.what();
+        }
+        ExpectSameFlat(store.Flat(), Flatten(start));
+    };
+    SceneChange orphan;
+    orphan.added.push_back(OrganNode(9001, "orphan", Rectangle(0.1, 0.1, 1), "leaf", 8999));
+    expect(orphan, ErrorCode::kNotFound, 9001);
+    SceneChange loop;  // the trunk under one of its own branches
+    Node trunk = axis;
+    trunk.parent = branch.id;
+    loop.updated.push_back(trunk);
+    expect(loop, ErrorCode::kCycle, axis.id);
+    SceneChange taken;
+    taken.added.push_back(
+        OrganNode(9001, start.NodeName(leaf), Rectangle(0.1, 0.1, 1), "leaf", leaf.parent));
+    expect(taken, ErrorCode::kAlreadyExists, 9001);
+    SceneChange twice;
+    twice.added.push_back(OrganNode(9001, "a", Rectangle(0.1, 0.1, 1), "leaf", leaf.parent));
+    twice.added.push_back(OrganNode(9001, "b", Rectangle(0.1, 0.1, 1), "leaf", leaf.parent));
+    expect(twice, ErrorCode::kAlreadyExists, 9001);
+}
+
+// Undo takes a change back whole: nodes, their order, the suns and the placed triangles.
+TEST(SceneStore, UndoRestoresTheSceneBefore) {
+    const Scene start = GrownTree();
+    SceneStore store(start);
+    const auto nth = [&](NodeType type, int k) {
+        std::vector<const Node*> found;
+        for (const Node& n : store.Get().nodes) {
+            if (n.type == type) found.push_back(&n);
+        }
+        return *found.at(k);
+    };
+    SceneChange change;
+    change.removed.push_back(nth(NodeType::kAxis, 3).id);
+    Node bent = nth(NodeType::kPhytomer, 1);
+    bent.parentFromLocal = glm::rotate(bent.parentFromLocal, 0.2, glm::dvec3(0, 1, 0));
+    change.updated.push_back(bent);
+    Node renamed = nth(NodeType::kLeaf, 0);
+    renamed.name = "renamed";
+    change.updated.push_back(renamed);
+    change.added.push_back(OrganNode(9001, "new", Rectangle(0.1, 0.1, 1), "leaf", bent.id));
+    change.suns = std::vector<Sun>{SunAt(20, 0, 300)};
+    store.Apply(change);
+    ASSERT_NE(store.Get().nodes.size(), start.nodes.size());
+    store.Undo();
+    ASSERT_EQ(store.Get().nodes.size(), start.nodes.size());
+    for (std::size_t i = 0; i < start.nodes.size(); ++i) {
+        EXPECT_EQ(store.Get().nodes[i].id, start.nodes[i].id);
+        EXPECT_EQ(store.Get().nodes[i].name, start.nodes[i].name);
+        EXPECT_EQ(store.Get().nodes[i].parentFromLocal, start.nodes[i].parentFromLocal);
+    }
+    EXPECT_EQ(store.Get().sources.suns.at(0).towardSun, start.sources.suns.at(0).towardSun);
+    ExpectSameFlat(store.Flat(), Flatten(start));
+    // And the store goes on from there as if the change had never come.
+    store.Apply(change);
+    Scene whole = store.Get();
+    ExpectSameFlat(store.Flat(), Flatten(whole));
 }
 
 }  // namespace
