@@ -205,9 +205,6 @@ class HrcSolver {
           bands_(static_cast<int>(scene.bands.size())),
           bins_(directions_.Size()) {
         for (const Receiver& receiver : flat.receivers) optics_.push_back(OpticsOf(receiver));
-        FindOrgans();
-        FindInnerSides(scene);
-        ScaleLobes();
         for (const Sun& sun : scene.sources.suns) AddSource(sun.towardSun, sun.normalIrradianceWm2);
         for (const Sky& sky : scene.sources.skies) {
             Sky discrete = sky;
@@ -298,14 +295,15 @@ class HrcSolver {
     // triangles that faces the organ's own surface is inside and gets no light. The
     // reference's rays find the same; a side facing out (a stem drawn as a strip, a tube
     // wound inwards) is lit as any surface.
-    void FindInnerSides(const Scene& scene) {
+    void FindInnerSides() {
         std::unordered_map<NodeId, NodeType> types;
-        for (const Node& node : scene.nodes) types[node.id] = node.type;
+        for (const Node& node : scene_.nodes) types[node.id] = node.type;
         inner_.assign(flat_.triangles.size(), 0);
-        for (const Receiver& receiver : flat_.receivers) {
-            if (receiver.kind != ReceiverKind::kOrgan) continue;
+        tbb::parallel_for(std::size_t{0}, flat_.receivers.size(), [&](std::size_t r) {
+            const Receiver& receiver = flat_.receivers[r];
+            if (receiver.kind != ReceiverKind::kOrgan) return;
             const NodeType type = types.at(receiver.node);
-            if (type != NodeType::kInternode && type != NodeType::kFruit) continue;
+            if (type != NodeType::kInternode && type != NodeType::kFruit) return;
             for (std::uint32_t t = receiver.firstTriangle;
                  t < receiver.firstTriangle + receiver.triangleCount; ++t) {
                 const Triangle& tri = flat_.triangles[t];
@@ -318,7 +316,7 @@ class HrcSolver {
                     }
                 }
             }
-        }
+        });
     }
 
     bool Inner(std::uint32_t triangle, int side) const { return inner_[triangle] >> side & 1; }
@@ -344,7 +342,7 @@ class HrcSolver {
     // directions.
     void ScaleLobes() {
         lobeScale_.assign(flat_.triangles.size(), {1.0, 1.0});
-        for (std::size_t t = 0; t < flat_.triangles.size(); ++t) {
+        tbb::parallel_for(std::size_t{0}, flat_.triangles.size(), [&](std::size_t t) {
             std::array<double, 2> integral{};
             for (int d = 0; d < bins_; ++d) {
                 const double cosine = glm::dot(flat_.triangles[t].normal, directions_.Direction(d));
@@ -354,7 +352,7 @@ class HrcSolver {
             for (int side : {kUpper, kLower}) {
                 if (integral[side] > 0.0) lobeScale_[t][side] = kPi / integral[side];
             }
-        }
+        });
     }
 
     // The side of patch p facing direction d of the set and p's lobe there (ScaleLobes).
@@ -1504,6 +1502,9 @@ void HrcSolver<kBands>::Extrapolate(double factor) {
 
 template <int kBands>
 void HrcSolver<kBands>::Solve(Solution& solution) {
+    FindOrgans();
+    FindInnerSides();
+    ScaleLobes();
     Grow();
     Index();
     for (std::uint32_t n : preOrder_) radiosity_[n][kUpper] = emission_[n];
