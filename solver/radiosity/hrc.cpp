@@ -1796,7 +1796,10 @@ Solution SolveWithBands(const Scene& scene, const FlatScene& flat, const RayScen
     } else {
         if (static_cast<int>(scene.bands.size()) == kBands) {
             const ResourceClock clock;
-            return HrcSolver<kBands>(scene, flat, rays, options).Run(clock);
+            Stopwatch watch;
+            HrcSolver<kBands> solver(scene, flat, rays, options);
+            spdlog::debug("hrc: hierarchy built in {:.3f} s", watch.Lap());
+            return solver.Run(clock);
         }
         return SolveWithBands<kBands + 1>(scene, flat, rays, options);
     }
