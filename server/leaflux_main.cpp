@@ -98,12 +98,16 @@ int RunSolve(const SolveCommand& command) {
     }
     std::cout << Summary(command.solver, scene, prepared.Flat(), solution) << std::endl;
     for (const LinkAudit& audit : solution.linkAudit) {
-        if (audit.links == 0 || audit.shotW <= 0.0) continue;  // nothing to set it against
-        std::printf(
-            "links %-24s %9lld: hand on %.6g W, rays from their senders land %.6g ± %.2g W"
-            " (ratio %.4f)\n",
-            audit.kind.c_str(), static_cast<long long>(audit.links), audit.handedW, audit.shotW,
-            audit.shotStderrW, audit.handedW / audit.shotW);
+        if (audit.links == 0) {  // the partition's check: rays where no link or two cover
+            std::printf("points %-23s: rays find %.6g ± %.2g W\n", audit.kind.c_str(), audit.foundW,
+                        audit.foundStderrW);
+        } else if (audit.foundW > 0.0) {
+            std::printf(
+                "links %-24s %9lld: hand on %.6g W, rays from their receivers find %.6g ± %.2g W"
+                " (ratio %.4f)\n",
+                audit.kind.c_str(), static_cast<long long>(audit.links), audit.handedW,
+                audit.foundW, audit.foundStderrW, audit.handedW / audit.foundW);
+        }
     }
     return 0;
 }
@@ -275,8 +279,9 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1e-9, 1.0));
     AddHrcSettings(*solveApp, solve.hrc, "--", "hrc: ");
     solveApp->add_flag("--audit-links", solve.hrc.auditLinks,
-                       "hrc: after the solve, set each kind of link against 64 rays shot from "
-                       "each link's sender (the power handed on, with the solution's radiosity)");
+                       "hrc: after the solve, set each kind of link against 64 rays from each "
+                       "side of every leaf patch (the power handed on, with the solution's "
+                       "radiosity), and check that the links cover every exchange once");
     solveApp
         ->add_option("--samples", solve.samples, "mc: paths per receiver (standard error ~ 1/sqrt)")
         ->check(CLI::Range(2, 1 << 26));

@@ -69,15 +69,17 @@ class ResourceClock {
     double wallStart_, cpuStart_;
 };
 
-// HRC's links of one kind against rays shot from their senders (HrcOptions::auditLinks):
-// the power the links hand on with the solution's radiosity, all bands together, and the
-// power that cosine-distributed rays from each sender, weighted by the radiosity of the
-// side they leave, land on its receiver first — a Monte Carlo estimate of the same
-// exchanges, with its standard error.
+// HRC's links of one kind against rays from their receivers (HrcOptions::auditLinks): the
+// power the links hand on with the solution's radiosity, all bands together, and what
+// cosine-distributed rays from every leaf patch side find — the radiosity of the side of
+// the point each ray hits, on the patch's area — where a link of that kind covers the
+// point hit: a Monte Carlo estimate of the same exchanges, with its standard error. Two
+// more rows, of no link, hold what the rays find where no link covers the point or two do:
+// nothing, when the links partition the exchanges as they must.
 struct LinkAudit {
     std::string kind;
     std::int64_t links = 0;
-    double handedW = 0.0, shotW = 0.0, shotStderrW = 0.0;
+    double handedW = 0.0, foundW = 0.0, foundStderrW = 0.0;
 };
 
 struct Solution {

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <numeric>
 #include <queue>
+#include <span>
 #include <unordered_map>
 
 #include "solver/check.h"
@@ -755,14 +756,32 @@ class HrcSolver {
             e.reach = e.geometric * ExposedArea(r, facing, e.geometricError);
             e.power = radiosity * e.reach;
         } else {
-            // 1/d² between centroids, times the mean of 1/|x − y|² over the two nodes' spread
-            // of area to second order, 1 + (σ_R² + σ_S²) / (3 d²): without it the transfer
-            // between near clusters is biased low (Jensen). Bounded for overlapping clusters.
-            const glm::dvec3 gap = S.centroid - R.centroid;
-            const double square =
-                std::max(glm::dot(gap, gap), 0.25 * std::pow(R.radius + S.radius, 2.0));
-            const double spread = (R.spread * R.spread + S.spread * S.spread) / (3.0 * square);
-            e.geometric = std::min(1.0 + spread, 2.0) / square;
+            // The mean of 1/|x − y|² over the two nodes' area, over pairs of their children
+            // (a node without children its own), each pair's 1/d² between centroids times its
+            // second-order correction for the children's spread, 1 + (σ₁² + σ₂²) / (3 d²),
+            // bounded for overlapping children. Taken for R and S whole, that correction
+            // assumes their area spread evenly in all directions and overshot: on the 500-leaf
+            // canopy at ε = 1e-4 the links between clusters at less than twice their radii
+            // handed on 1.013 of what rays from their receivers find (AuditLinks), over the
+            // pairs of children 0.994, and its NIR L2 error went from 1.10 to 1.04 %.
+            const auto partsOf = [](const HrcNode& node, const std::uint32_t& self) {
+                return node.children.empty() ? std::span<const std::uint32_t>(&self, 1)
+                                             : std::span<const std::uint32_t>(node.children);
+            };
+            double mean = 0.0;
+            for (std::uint32_t cr : partsOf(R, r)) {
+                const HrcNode& CR = hierarchy_[cr];
+                for (std::uint32_t cs : partsOf(S, s)) {
+                    const HrcNode& CS = hierarchy_[cs];
+                    const glm::dvec3 gap = CS.centroid - CR.centroid;
+                    const double square =
+                        std::max(glm::dot(gap, gap), 0.25 * std::pow(CR.radius + CS.radius, 2.0));
+                    const double spread =
+                        (CR.spread * CR.spread + CS.spread * CS.spread) / (3.0 * square);
+                    mean += CR.areaM2 * CS.areaM2 * std::min(1.0 + spread, 2.0) / square;
+                }
+            }
+            e.geometric = mean / (R.areaM2 * S.areaM2);
             // S of even radiosity B on both sides sends I = B P_S(ω) / π towards R and
             // 2 B A_S in all: the link hands R's area facing S no more than that.
             const DirectionSet::Interpolation back = directions_.Locate(-e.toSender);
@@ -1074,7 +1093,7 @@ class HrcSolver {
     double UpdateRadiosity();
     void Extrapolate(double factor);
     void Outputs(Solution& solution);
-    void AuditLinks(Solution& solution) const;
+    void AuditLinks(Solution& solution);
 
     const Scene& scene_;
     const FlatScene& flat_;
@@ -1610,78 +1629,111 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
 }
 
 template <int kBands>
-void HrcSolver<kBands>::AuditLinks(Solution& solution) const {
-    // The radiosity at a point a sender's ray leaves from: its patch's, or for a cluster the
-    // flat triangle's (Hierarchy::PatchOf).
-    enum Kind { kExact, kFromPatch, kFromCluster, kKinds };
-    struct Sum {
-        std::int64_t links = 0;
-        double handed = 0.0, shot = 0.0, variance = 0.0;
-        Sum& operator+=(const Sum& o) {
-            links += o.links, handed += o.handed, shot += o.shot, variance += o.variance;
-            return *this;
-        }
+void HrcSolver<kBands>::AuditLinks(Solution& solution) {
+    enum Kind { kExact, kFromPatch, kIntoPatch, kBetweenClusters, kNoLink, kTwoLinks, kKinds };
+    const auto kindOf = [&](std::uint32_t r, const NodeLink& link) {
+        if (link.exact) return kExact;
+        if (link.senderPatch) return kFromPatch;
+        return hierarchy_[r].patch ? kIntoPatch : kBetweenClusters;
     };
-    using Sums = std::array<Sum, kKinds>;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> all;  // receiver, link
-    for (std::uint32_t r = 0; r < links_.size(); ++r) {
-        for (std::uint32_t i = 0; i < links_[r].size(); ++i) all.push_back({r, i});
+    // What the links of each kind hand on: the light the leaf patches' outer sides gather
+    // through them alone, all bands, as push-down hands it on (a cluster's projected area
+    // counts the back faces of its solids, whose inner sides get none of it).
+    std::array<std::int64_t, kKinds> links{};
+    std::array<double, kKinds> handed{};
+    const std::vector<std::vector<NodeLink>> all = links_;
+    const std::vector<Sided> irradiance = irradiance_, sources = sourceSides_;
+    for (std::uint32_t n : leaves_) sourceSides_[n] = Sided{};
+    for (int kind = 0; kind < kNoLink; ++kind) {
+        for (std::uint32_t r = 0; r < all.size(); ++r) {
+            links_[r].clear();
+            for (const NodeLink& link : all[r]) {
+                if (kindOf(r, link) == kind) links_[r].push_back(link);
+            }
+            links[kind] += static_cast<std::int64_t>(links_[r].size());
+        }
+        Collect<false>();
+        for (std::uint32_t n : leaves_) {
+            for (int side : {kUpper, kLower}) {
+                if (Inner(hierarchy_[n].triangle, side)) continue;
+                for (int b = 0; b < bands_; ++b)
+                    handed[kind] += hierarchy_[n].areaM2 * irradiance_[n][side][b];
+            }
+        }
     }
+    links_ = all;
+    irradiance_ = irradiance;
+    sourceSides_ = sources;
+    // Per leaf patch side, what its rays find, by the kind of link that covers each point.
     constexpr int kShots = 64;
+    using Found = std::array<std::array<double, 2>, kKinds>;  // W and W² per kind
     using Range = tbb::blocked_range<std::size_t>;
-    const Sums sums = tbb::parallel_reduce(
-        Range(0, all.size()), Sums{},
-        [&](const Range& range, Sums acc) {
+    const Found found = tbb::parallel_reduce(
+        Range(0, leaves_.size()), Found{},
+        [&](const Range& range, Found acc) {
             SetFlushToZero();
-            for (std::size_t j = range.begin(); j != range.end(); ++j) {
-                const auto [r, i] = all[j];
-                const NodeLink& link = links_[r][i];
-                const HrcNode& S = hierarchy_[link.sender];
-                Sum& sum = acc[link.exact ? kExact : link.senderPatch ? kFromPatch : kFromCluster];
-                ++sum.links;
-                if (link.exact) {
-                    sum.handed += static_cast<double>(link.transfer[0] + link.transfer[1]) *
-                                  hierarchy_[r].areaM2 *
-                                  SideRadiosity(link.sender, link.senderSide);
-                } else if (link.Carries()) {
-                    const Spectrum sent = Sent(link);
-                    sum.handed += std::accumulate(sent.begin(), sent.begin() + bands_, 0.0) *
-                                  static_cast<double>(link.transfer[0]) *
-                                  ProjectedArea(r, glm::dvec3(link.toSender));
+            for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                const std::uint32_t n = leaves_[i];
+                const HrcNode& node = hierarchy_[n];
+                Random random(StreamSeed(0xA0D17, n));
+                for (int side : {kUpper, kLower}) {
+                    if (Inner(node.triangle, side)) continue;
+                    std::array<double, kKinds> sum{}, square{};
+                    for (int k = 0; k < kShots; ++k) {
+                        const Hierarchy::Point p =
+                            hierarchy_.Sample(n, random.Uniform(), random.Uniform());
+                        const glm::dvec3 omega =
+                            CosineHemisphere(side == kUpper ? node.normal : -node.normal,
+                                             (k + random.Uniform()) / kShots, random.Uniform());
+                        const RayHit hit = rays_.Trace({p.position, p.triangle}, omega);
+                        if (hit.fate != RayFate::kHit) continue;
+                        const glm::dvec3& y = hit.next.origin;
+                        // The leaf patch at y, and its side facing the ray.
+                        std::uint32_t at = hierarchy_.PatchOf(hit.triangle);
+                        for (bool down = true; down;) {
+                            down = false;
+                            for (std::uint32_t c : hierarchy_[at].children) {
+                                if (hierarchy_.Covers(c, hit.triangle, y)) {
+                                    at = c, down = true;
+                                    break;
+                                }
+                            }
+                        }
+                        const int facing =
+                            glm::dot(flat_.triangles[hit.triangle].normal, omega) < 0.0 ? kUpper
+                                                                                        : kLower;
+                        const double b = node.areaM2 * SideRadiosity(at, facing);
+                        int covering = 0;
+                        Kind kind = kNoLink;
+                        for (std::uint32_t r = n; r != kNoNode; r = hierarchy_[r].parent) {
+                            for (const NodeLink& link : links_[r]) {
+                                if (hierarchy_.Covers(link.sender, hit.triangle, y))
+                                    ++covering, kind = kindOf(r, link);
+                            }
+                        }
+                        if (covering > 1) kind = kTwoLinks;
+                        sum[kind] += b;
+                        square[kind] += b * b;
+                    }
+                    for (int k = 0; k < kKinds; ++k) {
+                        const double mean = sum[k] / kShots;
+                        acc[k][0] += mean;
+                        acc[k][1] += (square[k] / kShots - mean * mean) / (kShots - 1);
+                    }
                 }
-                Random random(StreamSeed(0xA0D17, r, link.sender));
-                double shot = 0.0, square = 0.0;
-                for (int k = 0; k < kShots; ++k) {
-                    const int side = k % 2;
-                    const Hierarchy::Point p =
-                        hierarchy_.Sample(link.sender, random.Uniform(), random.Uniform());
-                    const glm::dvec3 omega = CosineHemisphere(side == kUpper ? p.normal : -p.normal,
-                                                              random.Uniform(), random.Uniform());
-                    const RayHit hit = rays_.Trace({p.position, p.triangle}, omega);
-                    if (hit.fate != RayFate::kHit ||
-                        !hierarchy_.Covers(r, hit.triangle, hit.next.origin))
-                        continue;
-                    // Both sides of S send: 2 A_S B over the rays of both.
-                    const double w =
-                        2.0 * S.areaM2 *
-                        SideRadiosity(S.patch ? link.sender : hierarchy_.PatchOf(p.triangle), side);
-                    shot += w;
-                    square += w * w;
-                }
-                const double mean = shot / kShots;
-                sum.shot += mean;
-                sum.variance += (square / kShots - mean * mean) / (kShots - 1);
             }
             return acc;
         },
-        [](Sums a, const Sums& b) {
-            for (int k = 0; k < kKinds; ++k) a[k] += b[k];
+        [](Found a, const Found& b) {
+            for (int k = 0; k < kKinds; ++k) a[k][0] += b[k][0], a[k][1] += b[k][1];
             return a;
         });
-    const char* names[kKinds] = {"patch from patch (exact)", "from a patch", "from a cluster"};
+    const char* names[kKinds] = {"patch from patch (exact)", "from a patch",
+                                 "cluster into a patch",     "between clusters",
+                                 "covered by no link",       "covered by two links"};
     for (int k = 0; k < kKinds; ++k) {
         solution.linkAudit.push_back(
-            {names[k], sums[k].links, sums[k].handed, sums[k].shot, std::sqrt(sums[k].variance)});
+            {names[k], links[k], handed[k], found[k][0], std::sqrt(found[k][1])});
     }
 }
 

@@ -60,7 +60,8 @@ struct HrcOptions {
     // The light vectors (∫ L dω, ∫ L ω dω per leaf): false leaves them zero and gathers
     // only each side's irradiance.
     bool lightVectors = true;
-    // After the solve, every link against rays its sender shoots (Solution::linkAudit).
+    // After the solve, every kind of link against rays from the receivers, and the
+    // partition of the exchanges among the links checked (Solution::linkAudit).
     bool auditLinks = false;
     int threads = 0;  // 0: every core
     // A continuous sky is discretised into these cones for the hierarchy's links.
