@@ -1685,7 +1685,13 @@ void HrcSolver<kBands>::AuditLinks(Solution& solution) {
                         const glm::dvec3 omega =
                             CosineHemisphere(side == kUpper ? node.normal : -node.normal,
                                              (k + random.Uniform()) / kShots, random.Uniform());
-                        const RayHit hit = rays_.Trace({p.position, p.triangle}, omega);
+                        RayHit hit = rays_.Trace({p.position, p.triangle}, omega);
+                        // A triangle overlapping the patch in its plane (a mesh that repeats a
+                        // face) exchanges nothing with it: the ray goes on through.
+                        while (hit.fate == RayFate::kHit &&
+                               hierarchy_.PatchOf(hit.triangle) != kNoNode &&
+                               InPlane(node, hierarchy_[hierarchy_.PatchOf(hit.triangle)]))
+                            hit = rays_.Trace(hit.next, omega);
                         if (hit.fate != RayFate::kHit) continue;
                         const glm::dvec3& y = hit.next.origin;
                         // The leaf patch at y, and its side facing the ray.
