@@ -44,7 +44,7 @@ void SceneStore::Apply(SceneChange change) {
     Commit(plan, change);
 }
 
-SceneStore::Plan SceneStore::Check(SceneChange& change) const {
+SceneStore::Plan SceneStore::Check(const SceneChange& change) const {
     Plan plan;
     for (NodeId id : change.removed) {
         if (!kept_.count(id))

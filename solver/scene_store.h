@@ -68,7 +68,7 @@ class SceneStore {
         std::vector<std::pair<std::string, std::optional<NodeId>>> names;
     };
 
-    Plan Check(SceneChange& change) const;
+    Plan Check(const SceneChange& change) const;
     void Commit(Plan& plan, SceneChange& change);
     void SetKept(NodeId id, std::optional<Kept> value);
     void SetName(const std::string& name, std::optional<NodeId> owner);
