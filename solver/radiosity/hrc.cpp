@@ -389,8 +389,8 @@ class HrcSolver {
     // facing x, all bands: the link carries the visible share of the light the cluster
     // sends, not of its area, and the leaves of a crown that a ground patch sees are its
     // outer, sunlit ones. Weighted by area alone, the 10k tree's links from clusters into
-    // ground patches handed on 0.74 of what rays from their senders land and its NIR
-    // balance was 0.83 % off; now 0.80 and 0.38 %. The radiosity is that of when the link
+    // ground patches handed on 0.74 of what rays from their senders landed (the audit of then) and
+    // its NIR balance was 0.83 % off; now 0.80 and 0.38 %. The radiosity is that of when the link
     // is valued: the direct light's at first, the solution's in the refine–solve passes.
     // Counts the rays it traces in `rays`.
     Sight Visibility(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
@@ -731,8 +731,8 @@ class HrcSolver {
             // R is a cluster: S's solid angle averaged over R's children by area, each with
             // the second-order correction for the spread of its own area that clusters get.
             // Taken at R's centroid with R's spread, the correction overshot: on the dense
-            // canopy these links handed on 1.032 of what rays from their senders land (0.962
-            // uncorrected), over the children 1.016.
+            // canopy these links handed on 1.032 of what rays from their senders landed (the audit
+            // of then) (0.962 uncorrected), over the children 1.016.
             e.geometric = 0.0;
             for (std::uint32_t child : R.children) {
                 const HrcNode& C = hierarchy_[child];
@@ -811,14 +811,14 @@ class HrcSolver {
     // Patch ← patch: Lambert's formula per side, averaged over three points of R (the
     // degree-2 rule, barycentric (2/3, 1/6, 1/6)); the solid angle at R's centre. F is convex
     // in the distance, so its value at R's centre falls short of R's mean where S is near:
-    // on the dense canopy exact links handed on 0.967 of what rays from their senders land,
-    // with the three points 0.999, and its NIR balance at 1e-4 went from 1.87 to −0.48 %
-    // (0.02 % with EstimatePair's links from patches averaged over R's children).
-    // Every exact link into R takes the same points, so that in a closed room they still sum
-    // to one: three points for near links only lost 41 % of the closed box's light at
-    // ρ = 0.999, for all links the box keeps it within 0.5 %. Sixteen or 64 points (the
-    // converged mean) give 0.995 on the dense canopy and 1.06 on the seedling tray at
-    // ε = 1e-3, where three give 0.999 and 1.075: the tray's excess is not the rule's.
+    // on the dense canopy exact links handed on 0.967 of what rays from their senders landed (the
+    // audit of then), with the three points 0.999, and its NIR balance at 1e-4 went from 1.87 to
+    // −0.48 % (0.02 % with EstimatePair's links from patches averaged over R's children). Every
+    // exact link into R takes the same points, so that in a closed room they still sum to one:
+    // three points for near links only lost 41 % of the closed box's light at ρ = 0.999, for all
+    // links the box keeps it within 0.5 %. Sixteen or 64 points (the converged mean) give 0.995 on
+    // the dense canopy and 1.06 on the seedling tray at ε = 1e-3, where three give 0.999 and 1.075:
+    // the tray's excess is not the rule's.
     Estimate EstimateExact(std::uint32_t r, std::uint32_t s) const {
         const HrcNode& R = hierarchy_[r];
         const HrcNode& S = hierarchy_[s];
