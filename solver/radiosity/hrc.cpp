@@ -844,6 +844,14 @@ class HrcSolver {
             e.form.upper = upper ? form : 0.0;
             e.form.lower = upper ? 0.0 : form;
         }
+        // The inner side of a solid's face sees only the solid's inside: what lies beyond it
+        // is hidden by the solid, and the visibility rays, which weigh that side zero, would
+        // not take it off. Kept, the 10k tree's exact links handed 1.1 W onto its stems'
+        // inner sides.
+        const double unhidden = e.form.upper + e.form.lower;
+        if (Inner(R.triangle, kUpper)) e.form.upper = 0.0;
+        if (Inner(R.triangle, kLower)) e.form.lower = 0.0;
+        if (unhidden > 0.0) e.form.solidAngleSr *= (e.form.upper + e.form.lower) / unhidden;
         const double d = std::max(glm::length(S.centroid - R.centroid), 1e-300);
         // The form factor at R's centroid speaks for all of R only when R is small against
         // the distance; otherwise parts of R may see S fully (F up to 1 on each side).
