@@ -4,8 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <set>
-#include <unordered_map>
 
 #include "server/executor.h"
 #include "solver/error.h"
@@ -157,7 +155,7 @@ v1::CycleResult Session::Run(const v1::Cycle& cycle) {
         return result;
     }
     const Clock::time_point start = Clock::now();
-    store_.Apply(Change(cycle));  // validated whole, before anything is kept
+    store_.Apply(Change(cycle));  // checked against the scene it makes, then applied
     spdlog::debug("cycle {}: delta applied and the scene validated in {:.1f} ms", cycle.number(),
                   Milliseconds(start));
     v1::CycleResult result;

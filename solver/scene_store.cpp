@@ -225,8 +225,9 @@ void SceneStore::Commit(Plan& plan, SceneChange& change) {
     }
     if (!plan.removed.empty()) {
         for (std::size_t i = 0; i < scene_.nodes.size(); ++i) {
+            // Moved into the log: erase_if below reads only the ids, which stay.
             if (plan.removed.count(scene_.nodes[i].id))
-                log_->removed.emplace_back(i, scene_.nodes[i]);
+                log_->removed.emplace_back(i, std::move(scene_.nodes[i]));
         }
         std::erase_if(scene_.nodes, [&](const Node& n) { return plan.removed.count(n.id) > 0; });
         for (NodeId id : plan.removed) {
