@@ -99,11 +99,11 @@ int RunSolve(const SolveCommand& command) {
     std::cout << Summary(command.solver, scene, prepared.Flat(), solution) << std::endl;
     for (const LinkAudit& audit : solution.linkAudit) {
         if (audit.links == 0) {  // the partition's check: rays where no link or two cover
-            std::printf("points %-23s: rays find %.6g ± %.2g W\n", audit.kind.c_str(), audit.foundW,
+            std::printf("points %-41s: rays find %.6g ± %.2g W\n", audit.kind.c_str(), audit.foundW,
                         audit.foundStderrW);
         } else if (audit.foundW > 0.0) {
             std::printf(
-                "links %-24s %9lld: hand on %.6g W, rays from their receivers find %.6g ± %.2g W"
+                "links %-42s %9lld: hand on %.6g W, rays from their receivers find %.6g ± %.2g W"
                 " (ratio %.4f)\n",
                 audit.kind.c_str(), static_cast<long long>(audit.links), audit.handedW,
                 audit.foundW, audit.foundStderrW, audit.handedW / audit.foundW);

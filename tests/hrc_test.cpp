@@ -313,7 +313,7 @@ TEST(HrcTree, LinkAuditFindsTheLightThatDoesNotEscapeCoveredOnce) {
     SolverSettings settings = HrcSettings(1e-4);
     settings.hrc.auditLinks = true;
     const Solution hrc = Solve(prepared, settings);
-    ASSERT_EQ(hrc.linkAudit.size(), 6u);
+    ASSERT_EQ(hrc.linkAudit.size(), 7u);
     double sent = 0.0;
     for (std::size_t r = 0; r < prepared.Flat().receivers.size(); ++r) {
         const Receiver& receiver = prepared.Flat().receivers[r];

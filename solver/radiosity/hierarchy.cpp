@@ -87,6 +87,7 @@ std::uint32_t Hierarchy::AddPatch(std::uint32_t triangle) {
     const Triangle& t = flat_.triangles[triangle];
     HrcNode node;
     node.patch = true;
+    node.flat = true;
     node.a = t.a, node.b = t.b, node.c = t.c, node.normal = t.normal;
     node.triangle = triangle;
     node.receiver = t.receiver;
@@ -213,7 +214,21 @@ void Hierarchy::Finish(std::uint32_t index) {
             const HrcNode& c = nodes_[child];
             node.radius = std::max(node.radius, glm::length(c.centre - node.centre) + c.radius);
         }
+        FindPlane(node);
     }
+}
+
+void Hierarchy::FindPlane(HrcNode& cluster) const {
+    // Normals within 1e-9 of each other in cosine (45 µrad) and centroids within 1e-9 of the
+    // cluster's size of one plane: the rounding of a transformed quad's two triangles.
+    const HrcNode& first = nodes_[cluster.children.front()];
+    cluster.flat = std::all_of(cluster.children.begin(), cluster.children.end(), [&](auto child) {
+        const HrcNode& c = nodes_[child];
+        return c.flat && glm::dot(c.normal, first.normal) >= 1.0 - 1e-9 &&
+               std::abs(glm::dot(first.normal, c.centroid - first.centroid)) <=
+                   1e-9 * cluster.radius;
+    });
+    if (cluster.flat) cluster.normal = first.normal;
 }
 
 bool Hierarchy::Subdivide(std::uint32_t index, double minAreaM2) {
@@ -228,6 +243,7 @@ bool Hierarchy::Subdivide(std::uint32_t index, double minAreaM2) {
     for (const auto& corner : corners) {
         HrcNode child;
         child.patch = true;
+        child.flat = true;
         child.parent = index;
         child.a = corner[0], child.b = corner[1], child.c = corner[2];
         child.normal = parent.normal;

@@ -25,6 +25,9 @@ struct HrcNode {
     std::uint32_t parent = kNoNode;
     std::vector<std::uint32_t> children;
     bool patch = false;
+    // Every patch under the node lies in one plane with one normal, `normal` (a patch's
+    // always does): a flat leaf of several triangles, a wall.
+    bool flat = false;
     // Patches: the triangle (FlatScene local frame), its flat triangle and receiver.
     glm::dvec3 a{0.0}, b{0.0}, c{0.0}, normal{0.0};
     std::uint32_t triangle = 0;
@@ -75,6 +78,8 @@ class Hierarchy {
     // Groups children into at most kMaxChildren subtrees by median splits in space.
     std::uint32_t Constrain(std::vector<std::uint32_t> children);
     void Finish(std::uint32_t node);
+    // Sets a cluster's `flat` and `normal` from its children's.
+    void FindPlane(HrcNode& cluster) const;
 
     const FlatScene& flat_;
     std::vector<HrcNode> nodes_;
