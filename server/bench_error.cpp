@@ -174,6 +174,8 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
         hrcSetting += " cluster-tolerance=" + Number(options.hrc.clusterTolerance);
     if (options.hrc.directionLevel != defaults.directionLevel)
         hrcSetting += " directions=" + std::to_string(options.hrc.directionLevel);
+    if (options.hrc.exposureRays != defaults.exposureRays)
+        hrcSetting += " exposure-rays=" + std::to_string(options.hrc.exposureRays);
     for (int samples : options.monteCarloSamples) {
         Run run{"mc", "samples=" + std::to_string(samples), base};
         run.settings.kind = SolverKind::kMonteCarlo;

@@ -52,6 +52,11 @@ void AddHrcSettings(CLI::App& app, HrcOptions& hrc, const std::string& prefix,
     app.add_option(prefix + "direction-level", hrc.directionLevel,
                    label + "direction set of cluster light, 0..4 (4, 10, 34, 130, 514 directions)")
         ->check(CLI::Range(0, 4));
+    app.add_option(prefix + "exposure-rays", hrc.exposureRays,
+                   label +
+                       "rays per child of a cluster and direction finding how open it is towards "
+                       "the light the cluster hands down (0: evenly by area)")
+        ->check(CLI::Range(0, 1024));
 }
 
 int RunSolve(const SolveCommand& command) {

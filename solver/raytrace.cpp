@@ -27,10 +27,12 @@ int CopyIndex(int i, int j) {
 }
 
 // The intersect context with the periodic copy of the triangle rays leave from; the ray's
-// id holds that triangle, which the filter ignores.
+// id holds that triangle, which the filter ignores. With a group (RayScene::OccludedByGroup),
+// only the group's triangles in the tile itself count.
 struct StartContext {
     RTCIntersectContext context;
     int copy;
+    const RayScene::Group* group = nullptr;
 };
 
 void IgnoreStartTriangle(const RTCFilterFunctionNArguments* args) {
@@ -38,11 +40,14 @@ void IgnoreStartTriangle(const RTCFilterFunctionNArguments* args) {
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
         const unsigned triangle = RTCRayN_id(args->ray, args->N, i);
-        if (triangle == kNoTriangle) continue;
+        if (triangle == kNoTriangle && !start->group) continue;
         const unsigned instance = RTCHitN_instID(args->hit, args->N, i, 0);
         const int copy = instance == RTC_INVALID_GEOMETRY_ID ? 0 : static_cast<int>(instance);
-        if (RTCHitN_primID(args->hit, args->N, i) == triangle && copy == start->copy) {
-            args->valid[i] = 0;
+        const unsigned primitive = RTCHitN_primID(args->hit, args->N, i);
+        if (primitive == triangle && copy == start->copy) args->valid[i] = 0;
+        if (const RayScene::Group* group = start->group) {
+            const std::uint32_t rank = group->rank[primitive];
+            if (copy != 0 || rank < group->first || rank >= group->last) args->valid[i] = 0;
         }
     }
 }
@@ -274,6 +279,15 @@ void RayScene::Occluded(const std::vector<RayStart>& starts, const glm::dvec3& d
     rtcOccluded1M(top_, &context.context, rays.data(), static_cast<unsigned>(rays.size()),
                   sizeof(RTCRay));
     for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = rays[i].tfar < 0.0f;
+}
+
+bool RayScene::OccludedByGroup(const RayStart& start, const glm::dvec3& direction,
+                               double maxDistance, const Group& group) const {
+    StartContext context = MakeContext(start.copy);
+    context.group = &group;
+    RTCRay ray = MakeRay(start, direction, maxDistance);
+    rtcOccluded1(top_, &context.context, &ray);
+    return ray.tfar < 0.0f;
 }
 
 bool RayScene::Occluded(const RayStart& start, const glm::dvec3& direction,

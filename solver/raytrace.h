@@ -79,6 +79,16 @@ class RayScene {
     void Occluded(const std::vector<RayStart>& starts, const glm::dvec3& direction,
                   std::vector<std::uint8_t>& occluded) const;
 
+    // A group of triangles: those whose rank (an index by triangle) lies in [first, last).
+    struct Group {
+        const std::uint32_t* rank;
+        std::uint32_t first, last;
+    };
+    // Whether a triangle of the group lies along the ray within maxDistance, in the tile
+    // itself (a periodic scene's copies do not count): the shadow a group casts on itself.
+    bool OccludedByGroup(const RayStart& start, const glm::dvec3& direction, double maxDistance,
+                         const Group& group) const;
+
     const FlatScene& Flat() const { return flat_; }
     bool Periodic() const { return periodic_.has_value(); }
 

@@ -338,6 +338,51 @@ TEST(HrcTree, LinkAuditFindsTheLightThatDoesNotEscapeCoveredOnce) {
     RecordProperty("uncovered_w", std::to_string(uncovered));
 }
 
+// A cluster hands its children the light it gathers weighted by how open each is towards
+// it (HrcOptions::exposureRays). Two black leaves of one plant, one above the other, under
+// a small lamp 5 m up that lights the plant through one link: handed down evenly, each
+// leaf gets half of the light; by exposure, the top leaf nearly all of it, as the Monte
+// Carlo reference finds, and the two absorb the same power either way.
+TEST(HrcExposure, SharesOutTheLightAClusterGathersTowardsTheOpenLeaf) {
+    Scene scene = OneBandScene({{"leaf", Leaf(0, 0)}, {"lamp", Opaque(0)}});
+    Node plant;
+    plant.id = 10;
+    plant.type = NodeType::kPlant;
+    plant.name = "plant";
+    scene.nodes.push_back(plant);
+    scene.nodes.push_back(OrganNode(1, "top", Rectangle(0.2, 0.2, 1.1), "leaf", 10));
+    scene.nodes.push_back(OrganNode(2, "bottom", Rectangle(0.2, 0.2, 1.0), "leaf", 10));
+    scene.sources.emitters.push_back({"lamp", Rectangle(0.3, 0.3, 6.0, true), {5000.0}, "lamp"});
+    scene.Validate();
+    const PreparedScene prepared(scene);
+    SolverSettings settings = HrcSettings(1e-3);
+    const Solution open = Solve(prepared, settings);
+    settings.hrc.exposureRays = 0;
+    const Solution even = Solve(prepared, settings);
+    settings.kind = SolverKind::kMonteCarlo;
+    settings.monteCarlo.samplesPerReceiver = 4096;
+    const Solution reference = Solve(prepared, settings);
+    EXPECT_NEAR(open.balance[0].absorbedW, even.balance[0].absorbedW,
+                1e-9 * even.balance[0].absorbedW);
+    const BandLight& evenTop = even.light[0][0];
+    const BandLight& evenBottom = even.light[1][0];
+    EXPECT_NEAR(evenBottom.irradianceUpperWm2, evenTop.irradianceUpperWm2,
+                1e-9 * evenTop.irradianceUpperWm2)
+        << "the lamp must light the plant through one link";
+    for (std::size_t r : {0u, 1u}) {
+        const BandLight& want = reference.light[r][0];
+        const double error =
+            std::abs(open.light[r][0].irradianceUpperWm2 - want.irradianceUpperWm2);
+        const double evenError =
+            std::abs(even.light[r][0].irradianceUpperWm2 - want.irradianceUpperWm2);
+        std::printf("%s: reference %.4g ± %.2g, exposure %.4g, even %.4g W/m²\n",
+                    prepared.Flat().receivers[r].name.c_str(), want.irradianceUpperWm2,
+                    want.stderrUpperWm2, open.light[r][0].irradianceUpperWm2,
+                    even.light[r][0].irradianceUpperWm2);
+        EXPECT_LT(error, 0.5 * evenError - 4.6 * want.stderrUpperWm2);
+    }
+}
+
 // Direct light only: the sun's light arrives, what the leaves scatter does not. The top
 // leaf's upper side sees the sun alone either way; its lower side gets only what the
 // bottom leaf reflects, and the bottom leaf's shaded part only what the top one transmits.

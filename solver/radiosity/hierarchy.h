@@ -69,6 +69,10 @@ class Hierarchy {
     // is the mean of its parts'.
     std::uint32_t PatchOf(std::uint32_t triangle) const { return patchOf_[triangle]; }
 
+    // By flat triangle, its place in hierarchy order: a node's original triangles are
+    // those placed in [first, first + count).
+    const std::uint32_t* Ranks() const { return orderOf_.data(); }
+
     // Whether the point x of flat triangle `triangle` lies on the node's surfaces.
     bool Covers(std::uint32_t node, std::uint32_t triangle, const glm::dvec3& x) const;
 

@@ -656,6 +656,81 @@ class HrcSolver {
         return hierarchy_[n].patch || (n < planes_.size() && planes_[n]);
     }
 
+    // A cluster hands the light it gathers from a direction to its children by their area
+    // facing it, as though none shaded another: the organs deep in a crown or a canopy get
+    // as much as the exposed ones. Each child c of a cluster C (not flat) takes instead its
+    // share weighted by e_c(ω), the fraction of its area facing ω that C's own triangles
+    // leave open towards ω, over the mean of e over C's children: the light C gathers is all
+    // handed down. e is found by HrcOptions::exposureRays rays from c's points towards each
+    // direction of the 10-direction set and interpolated to the cluster light's set (with 34
+    // directions of their own, the 10k tree took 30 % longer for an error 2.02 → 1.97 %
+    // instead of 2.01 %). On the 500-leaf NIR canopy at ε = 1e-4 the NIR L2 error went from
+    // 0.985 to 0.911 %, on the dense canopy from 2.21 to 2.02 %.
+    void FindExposures() {
+        const int rays = options_.exposureRays;
+        if (rays <= 0) return;
+        const std::size_t size = hierarchy_.Size();
+        exposure_.assign(size * bins_, 1.0f);
+        exposed_.assign(size, 0);
+        std::vector<std::uint32_t> clusters;
+        for (std::uint32_t n = 0; n < size; ++n) {
+            if (!hierarchy_[n].patch && !Planar(n)) clusters.push_back(n);
+        }
+        const DirectionSet& coarse = DirectionSet::OfLevel(std::min(1, options_.directionLevel));
+        std::vector<DirectionSet::Interpolation> toCoarse;
+        for (int d = 0; d < bins_; ++d) toCoarse.push_back(coarse.Locate(directions_.Direction(d)));
+        tbb::parallel_for(std::size_t{0}, clusters.size(), [&](std::size_t i) {
+            SetFlushToZero();
+            const std::uint32_t n = clusters[i];
+            const HrcNode& C = hierarchy_[n];
+            const RayScene::Group group{hierarchy_.Ranks(), C.first, C.first + C.count};
+            std::vector<double> open(C.children.size() * bins_, 1.0);
+            std::vector<double> coarseOpen(coarse.Size(), 1.0);
+            for (std::size_t j = 0; j < C.children.size(); ++j) {
+                const std::uint32_t c = C.children[j];
+                exposed_[c] = 1;
+                for (int d = 0; d < coarse.Size(); ++d) {
+                    const glm::dvec3& omega = coarse.Direction(d);
+                    Random random(StreamSeed(0xE7905, c, d));
+                    double seen = 0.0, total = 0.0;
+                    for (int k = 0; k < rays; ++k) {
+                        const Hierarchy::Point p =
+                            hierarchy_.Sample(c, (k + random.Uniform()) / rays, random.Uniform());
+                        const double weight = ReceivingWeight(p.triangle, p.normal, omega);
+                        if (weight <= 0.0) continue;
+                        total += weight;
+                        if (!rays_.OccludedByGroup({p.position, p.triangle}, omega, 2.0 * C.radius,
+                                                   group))
+                            seen += weight;
+                    }
+                    coarseOpen[d] = total > 0.0 ? seen / total : 1.0;
+                }
+                for (int d = 0; d < bins_; ++d) {
+                    const DirectionSet::Interpolation& w = toCoarse[d];
+                    double value = 0.0;
+                    for (int k = 0; k < 3; ++k) value += w.weight[k] * coarseOpen[w.vertex[k]];
+                    open[j * bins_ + d] = value;
+                }
+            }
+            for (int d = 0; d < bins_; ++d) {
+                double facing = 0.0, lit = 0.0;
+                for (std::size_t j = 0; j < C.children.size(); ++j) {
+                    const HrcNode& c = hierarchy_[C.children[j]];
+                    const double area = c.patch ? c.areaM2 * BinCosine(c, d).second
+                                                : projected_[slot_[C.children[j]] * bins_ + d];
+                    facing += area;
+                    lit += area * open[j * bins_ + d];
+                }
+                if (lit <= 0.0) continue;
+                for (std::size_t j = 0; j < C.children.size(); ++j) {
+                    exposure_[static_cast<std::size_t>(C.children[j]) * bins_ + d] =
+                        static_cast<float>(open[j * bins_ + d] * facing / lit);
+                }
+            }
+        });
+    }
+    bool Exposed(std::uint32_t n) const { return n < exposed_.size() && exposed_[n]; }
+
     // Whether a link into node r hands the same light to organs that may see it unevenly:
     // r is a cluster with organs under it (HrcOptions::clusterTolerance).
     bool Shared(std::uint32_t r) const { return !hierarchy_[r].patch && organs_[r]; }
@@ -1214,8 +1289,10 @@ class HrcSolver {
     std::vector<SideOptics> optics_;
     std::vector<std::uint8_t> inner_;  // by flat triangle: bit s set when side s is inside
     std::vector<std::array<double, 2>> lobeScale_;  // by flat triangle and side: BinCosine
-    std::vector<std::uint8_t> organs_;  // by node of the hierarchy as built: 1 over an organ
-    std::vector<std::uint8_t> planes_;  // by node of the hierarchy as built: FindPlanes
+    std::vector<std::uint8_t> organs_;   // by node of the hierarchy as built: 1 over an organ
+    std::vector<std::uint8_t> planes_;   // by node of the hierarchy as built: FindPlanes
+    std::vector<float> exposure_;        // [node as built][bin]: FindExposures
+    std::vector<std::uint8_t> exposed_;  // by node as built: a child of a cluster not flat
     std::vector<DirectionalSource> sources_;
     double totalPower_ = 0.0;
     std::int64_t rayCount_ = 0;
@@ -1352,9 +1429,11 @@ void HrcSolver<kBands>::DescendAll(std::size_t width, Holds holds, Add add, Top 
     tbb::parallel_for(std::size_t{0}, subtrees_.size(), [&](std::size_t t) {
         const std::uint32_t start = preOrder_[subtrees_[t].first];
         std::vector<double> above(width, 0.0);
+        std::vector<std::uint32_t> chain;  // handed down from the root, as Descend does
         for (std::uint32_t m = hierarchy_[start].parent; m != kNoNode; m = hierarchy_[m].parent) {
-            if (holds(m)) add(m, above);
+            if (holds(m)) chain.push_back(m);
         }
+        for (auto m = chain.rbegin(); m != chain.rend(); ++m) add(*m, above);
         Descend(start, above, holds, add, top);
     });
 }
@@ -1534,8 +1613,17 @@ void HrcSolver<kBands>::PushSources() {
 template <int kBands>
 template <bool kDirections>
 void HrcSolver<kBands>::PushDown() {
-    const auto holds = [&](std::uint32_t n) { return !Planar(n) && !links_[n].empty(); };
+    const auto gathers = [&](std::uint32_t n) { return !Planar(n) && !links_[n].empty(); };
+    const auto holds = [&](std::uint32_t n) { return gathers(n) || Exposed(n); };
     const auto add = [&](std::uint32_t n, std::vector<double>& bins) {
+        if (Exposed(n)) {
+            const float* share = &exposure_[static_cast<std::size_t>(n) * bins_];
+            for (int d = 0; d < bins_; ++d) {
+                for (int k = 0; k < bands_; ++k)
+                    bins[d * bands_ + k] *= static_cast<double>(share[d]);
+            }
+        }
+        if (!gathers(n)) return;
         const double* in = &gatheredBins_[static_cast<std::size_t>(slot_[n]) * bins_ * bands_];
         for (int i = 0; i < bins_ * bands_; ++i) bins[i] += in[i];
     };
@@ -1640,6 +1728,7 @@ void HrcSolver<kBands>::Solve(Solution& solution) {
     ScaleLobes();
     Grow();
     Index();
+    FindExposures();
     for (std::uint32_t n : preOrder_) radiosity_[n][kUpper] = emission_[n];
     // The power the sources bring in, unoccluded: the scale of every link's error.
     for (const DirectionalSource& source : sources_) {

@@ -50,7 +50,13 @@ struct HrcOptions {
     // Per link from a sun or a sky cone: direct light is most of what a leaf gets, and
     // there are few such links.
     int sourceRays = 32;
-    int directionLevel = 2;   // direction set of cluster light: 2 → 34 directions
+    int directionLevel = 2;  // direction set of cluster light: 2 → 34 directions
+    // A cluster hands the light it gathers to its children weighted by how open each is
+    // towards the light within the cluster (HrcSolver::FindExposures): rays per child and
+    // direction of the 10-direction set. 0: evenly by area facing the light, as the clusters
+    // of Sillion 1995. It costs 80 short rays per node: 2–5 % of the 500-leaf canopy's time,
+    // 10–20 % of the 10k tree's, whose error it leaves as it was (README).
+    int exposureRays = 8;
     double tolerance = 1e-5;  // iteration stops when the change still to come is less
                               // than this times the largest radiosity
     int maxIterations = 2000;
