@@ -28,7 +28,7 @@ SCENES = {
                ["--reference-samples", "8192", "--hrc-epsilon", "1e-3,1e-4,1e-5,1e-6"]),
     "tree10k": (["--leaves", "10000", "--seed", "2", "--sky-cones", "turtle46"],
                 "generated tree, 10,000 leaves, sun + 46-cone overcast sky",
-                ["--reference-samples", "8192", "--hrc-epsilon", "1e-3,1e-4,1e-5,1e-6"]),
+                ["--reference-samples", "8192", "--hrc-epsilon", "1e-3,1e-4,5e-5,1e-5,1e-6"]),
     "tree119k": (["--leaves", "44500", "--seed", "2", "--sky-cones", "turtle46"],
                  "generated tree of 119k triangles (44,500 leaves and their internodes), "
                  "sun + 46-cone overcast sky",
@@ -42,7 +42,7 @@ SCENES = {
                   "random canopy, 500 leaves, LAI 3, NIR ρ = τ = 0.45, sun only (HRC's goal: "
                   "1 % L2 in NIR in 0.3 s)",
                   # The goal's scene: a reference of 16,384 paths would add 0.45 % of noise.
-                  ["--reference-samples", "65536", "--hrc-epsilon", "1e-3,1e-4,1e-5"]),
+                  ["--reference-samples", "65536", "--hrc-epsilon", "1e-3,2e-4,1e-4,1e-5"]),
     "bac1": (None, "Caribu's seedling tray bac1.can (2,270 triangles) under the 46-direction "
                    "overcast sky of Turtle46soc.light",
              ["--reference-samples", "16384", "--hrc-epsilon", "1e-3,1e-4,1e-5"]),

@@ -679,6 +679,7 @@ class HrcSolver {
         const DirectionSet& coarse = DirectionSet::OfLevel(std::min(1, options_.directionLevel));
         std::vector<DirectionSet::Interpolation> toCoarse;
         for (int d = 0; d < bins_; ++d) toCoarse.push_back(coarse.Locate(directions_.Direction(d)));
+        std::atomic<std::int64_t> traced{0};
         tbb::parallel_for(std::size_t{0}, clusters.size(), [&](std::size_t i) {
             SetFlushToZero();
             const std::uint32_t n = clusters[i];
@@ -686,6 +687,7 @@ class HrcSolver {
             const RayScene::Group group{hierarchy_.Ranks(), C.first, C.first + C.count};
             std::vector<double> open(C.children.size() * bins_, 1.0);
             std::vector<double> coarseOpen(coarse.Size(), 1.0);
+            std::int64_t local = 0;
             for (std::size_t j = 0; j < C.children.size(); ++j) {
                 const std::uint32_t c = C.children[j];
                 exposed_[c] = 1;
@@ -704,6 +706,7 @@ class HrcSolver {
                             seen += weight;
                     }
                     coarseOpen[d] = total > 0.0 ? seen / total : 1.0;
+                    local += rays;
                 }
                 for (int d = 0; d < bins_; ++d) {
                     const DirectionSet::Interpolation& w = toCoarse[d];
@@ -727,7 +730,9 @@ class HrcSolver {
                         static_cast<float>(open[j * bins_ + d] * facing / lit);
                 }
             }
+            traced += local;
         });
+        rayCount_ += traced;
     }
     bool Exposed(std::uint32_t n) const { return n < exposed_.size() && exposed_[n]; }
 
@@ -905,7 +910,9 @@ class HrcSolver {
             if (Planar(r)) {
                 e.form = PlanesForm(r, s);
                 e.sided = true;
-                e.reach = (R.radius > 0.5 * d ? 1.0 : e.form.upper + e.form.lower) * R.areaM2;
+                // Near, any part of R may see S whole; but no more than S sends from a side.
+                e.reach = std::min(
+                    (R.radius > 0.5 * d ? 1.0 : e.form.upper + e.form.lower) * R.areaM2, S.areaM2);
             } else {
                 // S's solid angle (PlaneSolidAngle) averaged over R's children by area, each
                 // with the second-order correction for the spread of its own area that
