@@ -11,8 +11,8 @@
 // analytic point-to-polygon form factor, bounded in the near field, averaged over three points of
 // the receiver; between two planes, one of them a flat cluster, the same over their parts. A
 // cluster hands the light it gathers to its children weighted by how open each is towards it
-// inside the cluster (HrcOptions::exposureRays). Visibility is the unoccluded fraction of deterministic stratified rays through Embree,
-// each ray weighted by the form factor's kernel.
+// inside the cluster (HrcOptions::exposureRays). Visibility is the unoccluded fraction of
+// deterministic stratified rays through Embree, each ray weighted by the form factor's kernel.
 //
 // Refinement: a link is split (the larger node, or a patch subdivided into four) while its
 // estimated error — the power it carries times its geometric error ((r_R + r_S)/d)² plus its
