@@ -46,6 +46,26 @@ TEST(RayScene, LeavesItsStartTriangleEvenOneMicrometreFromTheNext) {
     EXPECT_EQ(rays.Trace({origin, 0}, {0, 0, -1}).fate, RayFate::kEscapedDown);
 }
 
+// Only the group's triangles block: three plates stacked at z = 0, 1 and 2, each of two
+// triangles; a ray up from below the first passes the plates outside the group.
+TEST(RayScene, ASelfShadowQuerySeesOnlyItsGroup) {
+    const FlatScene flat = Plates({Rectangle(1, 1, 0), Rectangle(1, 1, 1), Rectangle(1, 1, 2)});
+    const RayScene rays(flat, std::nullopt);
+    const std::vector<std::uint32_t> rank = {0, 1, 2, 3, 4, 5};  // triangle t at place t
+    const RayStart below{flat.ToLocal({0.1, 0.2, -1})};
+    const RayScene::Group middle{rank.data(), 2, 4}, top{rank.data(), 4, 6},
+        none{rank.data(), 0, 0};
+    EXPECT_TRUE(rays.OccludedByGroup(below, {0, 0, 1}, 10.0, middle));
+    EXPECT_TRUE(rays.OccludedByGroup(below, {0, 0, 1}, 10.0, top));
+    EXPECT_FALSE(rays.OccludedByGroup(below, {0, 0, 1}, 2.5, top));  // ends short of it
+    EXPECT_FALSE(rays.OccludedByGroup(below, {0, 0, 1}, 10.0, none));
+    // Leaving a triangle of the group, the ray does not see that triangle.
+    const Triangle& start = flat.triangles[2];
+    const RayStart onMiddle{(start.a + start.b + start.c) / 3.0, 2};
+    EXPECT_FALSE(rays.OccludedByGroup(onMiddle, {0, 0, 1}, 10.0, middle));
+    EXPECT_TRUE(rays.OccludedByGroup(onMiddle, {0, 0, 1}, 10.0, top));
+}
+
 TEST(RayScene, TracesRaysOfOneDirectionTogetherAsOneByOne) {
     // Plates 1 µm to 0.3 m apart, shifted sideways: rays leave every triangle (and points
     // off the surfaces) towards one sun, some blocked, some not.
