@@ -241,11 +241,12 @@ void SceneStore::Commit(Plan& plan, SceneChange& change) {
     }
     log_->added = change.added.size();
     for (auto& [id, kept] : next) SetKept(id, std::move(kept));
+    // Places after the removed nodes moved up: found again before they are read.
+    if (!plan.removed.empty()) Reindex();
     for (NodeId id : plan.order) {
         const Node& node = scene_.nodes[kept_.at(id).at];
         if (node.organ) SetName(scene_.NodeName(node), id);
     }
-    if (!plan.removed.empty()) Reindex();
 }
 
 void SceneStore::Undo() {

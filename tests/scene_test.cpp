@@ -425,6 +425,36 @@ TEST(SceneStore, RejectsWhatWholeValidationRejects) {
 }
 
 // Undo takes a change back whole: nodes, their order, the suns and the placed triangles.
+// A change that removes a node and updates one placed after it: the updated organ keeps its
+// name, which no other may take afterwards, and the names the removed one gave up are free.
+TEST(SceneStore, KeepsTheNamesOfOrgansUpdatedWhereNodesAreRemoved) {
+    Scene start = OneBandScene({{"leaf", Leaf(0.1, 0.05)}});
+    for (NodeId id = 1; id <= 4; ++id) {
+        start.nodes.push_back(OrganNode(id, "leaf" + std::to_string(id),
+                                        Rectangle(0.1, 0.1, 0.2 * static_cast<double>(id)),
+                                        "leaf"));
+    }
+    SceneStore store(start);
+    SceneChange change;
+    change.removed.push_back(1);
+    Node moved = start.nodes[2];  // leaf3, raised
+    moved.organ->mesh = Rectangle(0.1, 0.1, 2.0);
+    change.updated.push_back(moved);
+    store.Apply(change);
+    SceneChange taken;
+    taken.added.push_back(OrganNode(5, "leaf3", Rectangle(0.1, 0.1, 3.0), "leaf"));
+    try {
+        store.Apply(taken);
+        ADD_FAILURE() << "a second organ named leaf3 was accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.Code(), ErrorCode::kAlreadyExists) << e.what();
+        EXPECT_EQ(e.Node(), std::optional<std::uint64_t>(5)) << e.what();
+    }
+    SceneChange free;
+    free.added.push_back(OrganNode(5, "leaf1", Rectangle(0.1, 0.1, 3.0), "leaf"));
+    EXPECT_NO_THROW(store.Apply(free));
+}
+
 TEST(SceneStore, UndoRestoresTheSceneBefore) {
     const Scene start = GrownTree();
     SceneStore store(start);
