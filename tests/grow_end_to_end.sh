@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # leafluxd and leaflux-grow as users run them: the daemon on a loopback port, three cycles
-# of the wall-hole plant, a row per cycle, then a clean shutdown through the protocol.
+# of the wall-hole plant, a row per cycle, 14 more under direct light only in a session of
+# their own, then a clean shutdown through the protocol.
 # Usage: grow_end_to_end.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
 build=$1 source=$2
@@ -17,7 +18,12 @@ done
     --cycles 3 --endpoint "$endpoint" --out "$out" --ply-cycles 3 --quiet
 test "$(wc -l < "$out/cycles.csv")" -eq 4 || { echo "cycles.csv should have 3 rows"; exit 1; }
 test -s "$out/cycle3.ply" || { echo "no PLY for cycle 3"; exit 1; }
+# Under direct light only the plant sheds organs: from cycle 11 on, deltas remove nodes and
+# update others in one change.
+"$build/growth_stub/leaflux-grow" --scenario "$source/growth_stub/scenarios/wall-hole.txtpb" \
+    --cycles 14 --endpoint "$endpoint" --out "$out/direct_only" --direct-only --quiet
+test "$(wc -l < "$out/direct_only/cycles.csv")" -eq 15 || { echo "direct_only/cycles.csv should have 14 rows"; exit 1; }
 "$build/server/leaflux" client --endpoint "$endpoint" shutdown > /dev/null
 wait $daemon  # exits 0 after a clean shutdown
 trap 'rm -rf "$out"' EXIT
-echo "leafluxd + leaflux-grow: 3 cycles, clean shutdown"
+echo "leafluxd + leaflux-grow: 3 cycles, 14 under direct light, clean shutdown"
