@@ -671,7 +671,6 @@ class HrcSolver {
         if (rays <= 0) return;
         const std::size_t size = hierarchy_.Size();
         exposure_.assign(size * bins_, 1.0f);
-        exposed_.assign(size, 0);
         std::vector<std::uint32_t> clusters;
         for (std::uint32_t n = 0; n < size; ++n) {
             if (!hierarchy_[n].patch && !Planar(n)) clusters.push_back(n);
@@ -690,7 +689,6 @@ class HrcSolver {
             std::int64_t local = 0;
             for (std::size_t j = 0; j < C.children.size(); ++j) {
                 const std::uint32_t c = C.children[j];
-                exposed_[c] = 1;
                 for (int d = 0; d < coarse.Size(); ++d) {
                     const glm::dvec3& omega = coarse.Direction(d);
                     Random random(StreamSeed(0xE7905, c, d));
@@ -734,7 +732,12 @@ class HrcSolver {
         });
         rayCount_ += traced;
     }
-    bool Exposed(std::uint32_t n) const { return n < exposed_.size() && exposed_[n]; }
+    // Whether node n takes a share of its parent's light by exposure: a node the hierarchy
+    // was built with, under a cluster that is not flat.
+    bool Exposed(std::uint32_t n) const {
+        const std::uint32_t parent = hierarchy_[n].parent;
+        return n < exposure_.size() / bins_ && parent != kNoNode && !Planar(parent);
+    }
 
     // Whether a link into node r hands the same light to organs that may see it unevenly:
     // r is a cluster with organs under it (HrcOptions::clusterTolerance).
@@ -829,6 +832,13 @@ class HrcSolver {
         return below == 0.0 && above == 0.0;
     }
 
+    // The degree-2 rule's three points of a patch (barycentric (2/3, 1/6, 1/6)), where exact
+    // links take a receiver's form factor (EstimateExact).
+    static std::array<glm::dvec3, 3> ThreePoints(const HrcNode& p) {
+        return {(4.0 * p.a + p.b + p.c) / 6.0, (p.a + 4.0 * p.b + p.c) / 6.0,
+                (p.a + p.b + 4.0 * p.c) / 6.0};
+    }
+
     // A plane's parts, whose form factors and solid angles add up to its own: a patch itself,
     // a flat cluster its children.
     std::span<const std::uint32_t> PlaneParts(const std::uint32_t& n) const {
@@ -870,11 +880,8 @@ class HrcSolver {
         for (std::uint32_t child : PlaneParts(r)) {
             const HrcNode& C = hierarchy_[child];
             const double share = C.areaM2 / R.areaM2;
-            std::array<glm::dvec3, 3> points = {C.centroid, C.centroid, C.centroid};
-            if (C.patch) {
-                points = {(4.0 * C.a + C.b + C.c) / 6.0, (C.a + 4.0 * C.b + C.c) / 6.0,
-                          (C.a + C.b + 4.0 * C.c) / 6.0};
-            }
+            const std::array<glm::dvec3, 3> points =
+                C.patch ? ThreePoints(C) : std::array{C.centroid, C.centroid, C.centroid};
             for (std::uint32_t part : PlaneParts(s)) {
                 const HrcNode& P = hierarchy_[part];
                 SidedFormFactor f;
@@ -1005,9 +1012,8 @@ class HrcSolver {
         const HrcNode& S = hierarchy_[s];
         Estimate e;
         const glm::dvec3 x = (R.a + R.b + R.c) / 3.0, y = (S.a + S.b + S.c) / 3.0;
-        const glm::dvec3 points[3] = {(4.0 * R.a + R.b + R.c) / 6.0, (R.a + 4.0 * R.b + R.c) / 6.0,
-                                      (R.a + R.b + 4.0 * R.c) / 6.0};
-        e.form = MeanPointToTriangle(x, points, 3, R.normal, S.a, S.b, S.c);
+        const std::array<glm::dvec3, 3> points = ThreePoints(R);
+        e.form = MeanPointToTriangle(x, points.data(), 3, R.normal, S.a, S.b, S.c);
         e.senderSide = glm::dot(S.normal, x - y) >= 0.0 ? kUpper : kLower;
         e.toSender = glm::normalize(y - x);
         if (S.areaM2 < R.areaM2 / 16.0) {
@@ -1296,10 +1302,9 @@ class HrcSolver {
     std::vector<SideOptics> optics_;
     std::vector<std::uint8_t> inner_;  // by flat triangle: bit s set when side s is inside
     std::vector<std::array<double, 2>> lobeScale_;  // by flat triangle and side: BinCosine
-    std::vector<std::uint8_t> organs_;   // by node of the hierarchy as built: 1 over an organ
-    std::vector<std::uint8_t> planes_;   // by node of the hierarchy as built: FindPlanes
-    std::vector<float> exposure_;        // [node as built][bin]: FindExposures
-    std::vector<std::uint8_t> exposed_;  // by node as built: a child of a cluster not flat
+    std::vector<std::uint8_t> organs_;  // by node of the hierarchy as built: 1 over an organ
+    std::vector<std::uint8_t> planes_;  // by node of the hierarchy as built: FindPlanes
+    std::vector<float> exposure_;       // [node as built][bin]: FindExposures
     std::vector<DirectionalSource> sources_;
     double totalPower_ = 0.0;
     std::int64_t rayCount_ = 0;
