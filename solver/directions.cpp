@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <numbers>
 #include <utility>
 
 #include "solver/check.h"
@@ -20,12 +22,59 @@ bool InsideFace(const glm::dvec3& d, const std::array<glm::dvec3, 3>& edges) {
     return glm::dot(edges[0], d) >= kTolerance && glm::dot(edges[1], d) >= kTolerance &&
            glm::dot(edges[2], d) >= kTolerance;
 }
+
+// atan(u) for |u| ≤ tan(π/64) ≈ 0.049: its Taylor series to u¹³ (the next term is under
+// 1e-19 of u), evaluated in pairs so that the sums do not wait on each other.
+double SmallArctangent(double u) {
+    constexpr double c1 = -1.0 / 3, c2 = 1.0 / 5, c3 = -1.0 / 7, c4 = 1.0 / 9, c5 = -1.0 / 11,
+                     c6 = 1.0 / 13;
+    const double u2 = u * u, u4 = u2 * u2;
+    const double low = c1 + u2 * c2, middle = c3 + u2 * c4, high = c5 + u2 * c6;
+    return u + u * u2 * (low + u4 * (middle + u4 * high));
+}
 }  // namespace
+
+double Angle(double sine, double cosine) {
+    // atan(t) for t = smaller / larger of |sine|, |cosine| in [0, 1], from the nearest of
+    // the centres tan(kπ/32), k = 0..8: atan(t) = kπ/32 + atan((t − c) / (1 + t c)), the
+    // remainder within ±tan(π/64). One division: t's is folded into the remainder's.
+    constexpr int kCentres = 9;
+    struct Table {
+        std::array<double, kCentres> centre, angle;
+        std::array<double, kCentres - 1> bound;  // tan((2k + 1)π/64): centre k + 1 is nearer above
+    };
+    static const Table table = [] {
+        Table t;
+        for (int k = 0; k < kCentres; ++k) {
+            t.angle[k] = k * std::numbers::pi / 32.0;
+            t.centre[k] = k == kCentres - 1 ? 1.0 : std::tan(t.angle[k]);
+        }
+        for (int k = 0; k + 1 < kCentres; ++k)
+            t.bound[k] = std::tan((2 * k + 1) * std::numbers::pi / 64.0);
+        return t;
+    }();
+    const double a = std::abs(cosine);
+    if (!(sine > 0.0) || !(a < std::numeric_limits<double>::infinity())) {
+        return std::atan2(sine, cosine);  // on an axis, infinite or not a number
+    }
+    const bool steep = sine > a;
+    const double smaller = steep ? a : sine, larger = steep ? sine : a;
+    int k = 0;
+    for (double bound : table.bound) k += smaller > bound * larger;
+    const double c = table.centre[k];
+    const double angle =
+        table.angle[k] + SmallArctangent((smaller - c * larger) / (larger + c * smaller));
+    // Reflected by arithmetic rather than branches, which the data would mispredict: the
+    // steep octant about π/4, the obtuse quadrant about π/2.
+    const double steepAngle = steep * (std::numbers::pi / 2.0) + (1.0 - 2.0 * steep) * angle;
+    const double obtuse = cosine < 0.0;
+    return obtuse * std::numbers::pi + (1.0 - 2.0 * obtuse) * steepAngle;
+}
 
 double SphericalTriangleSolidAngle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
     const double numerator = std::abs(glm::dot(a, glm::cross(b, c)));
     const double denominator = 1.0 + glm::dot(a, b) + glm::dot(b, c) + glm::dot(c, a);
-    return 2.0 * std::atan2(numerator, denominator);
+    return 2.0 * Angle(numerator, denominator);
 }
 
 DirectionSet::DirectionSet(int level) {

@@ -52,6 +52,12 @@ class DirectionSet {
     std::vector<std::vector<std::array<glm::dvec3, 3>>> edges_;
 };
 
+// The angle in [0, π] with this sine and cosine, both scaled by the same positive factor
+// (|a × b| and a · b of two vectors): std::atan2 for a sine ≥ 0, to a few ulp, without its
+// general cases. Form factors take one per polygon edge, and refinement finds a dozen form
+// factors per link it judges.
+double Angle(double sine, double cosine);
+
 // Solid angle (sr) of the spherical triangle with unit vertices a, b, c
 // (Van Oosterom & Strackee 1983).
 double SphericalTriangleSolidAngle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);

@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+#include <numbers>
+
 #include "solver/sampling.h"
 
 namespace leaflux {
@@ -87,6 +91,36 @@ TEST(DirectionSet, EveryDirectionLiesInAFaceWithValidWeights) {
         // The face is the one around d: its vertices are within one face size.
         for (int v : located.vertex) EXPECT_GT(glm::dot(set.Direction(v), d), 0.95);
     }
+}
+
+// Angle is std::atan2 for a sine ≥ 0, to a few ulp: over every octant of the half-plane,
+// at the bounds between its remainders' centres, near the axes and at extreme magnitudes.
+TEST(Angle, IsTheArctangentOfTheHalfPlane) {
+    Random random(7);
+    double worst = 0.0;
+    auto check = [&](double sine, double cosine) {
+        const double want = std::atan2(sine, cosine), got = Angle(sine, cosine);
+        worst = std::max(worst, want > 0.0 ? std::abs(got - want) / want : std::abs(got));
+    };
+    for (int i = 0; i < 200000; ++i) {
+        const double angle = std::numbers::pi * random.Uniform();
+        const double scale = std::ldexp(1.0, static_cast<int>(random.Uniform() * 400.0) - 200);
+        check(scale * std::sin(angle), scale * std::cos(angle));
+    }
+    for (int k = 0; k <= 16; ++k) {
+        for (double nudge : {1e-12, 0.0, -1e-12}) {
+            const double angle = std::max(k * std::numbers::pi / 32.0 + nudge, 0.0);
+            check(std::sin(angle), std::cos(angle));
+            check(std::sin(angle), -std::cos(angle));
+        }
+    }
+    for (double tiny : {1e-300, 1e-200, 1e-20, 1e-9}) {
+        check(tiny, 1.0), check(tiny, -1.0), check(1.0, tiny), check(1.0, -tiny);
+    }
+    EXPECT_LT(worst, 4.0 * std::numeric_limits<double>::epsilon());
+    EXPECT_EQ(Angle(0.0, 1.0), 0.0);
+    EXPECT_EQ(Angle(0.0, -1.0), std::numbers::pi);
+    EXPECT_EQ(Angle(1.0, 0.0), std::numbers::pi / 2.0);
 }
 
 }  // namespace

@@ -36,14 +36,13 @@ double PolygonAbove(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3* 
                     std::size_t count) {
     if (count < 3) return 0.0;
     double sum = 0.0;
+    glm::dvec3 r0 = polygon[count - 1] - x;  // each edge from the previous corner
     for (std::size_t i = 0; i < count; ++i) {
-        const glm::dvec3 r0 = polygon[i] - x;
-        const glm::dvec3 r1 = polygon[(i + 1) % count] - x;
+        const glm::dvec3 r1 = polygon[i] - x;
         const glm::dvec3 cross = glm::cross(r0, r1);
         const double length = glm::length(cross);
-        if (length <= 0.0) continue;  // an edge seen end-on adds nothing
-        const double angle = std::atan2(length, glm::dot(r0, r1));
-        sum += angle * glm::dot(n, cross) / length;
+        if (length > 0.0) sum += Angle(length, glm::dot(r0, r1)) * glm::dot(n, cross) / length;
+        r0 = r1;  // an edge seen end-on (length 0) adds nothing
     }
     return std::min(1.0, std::abs(sum) / (2.0 * glm::pi<double>()));
 }
