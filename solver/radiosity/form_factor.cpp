@@ -56,17 +56,16 @@ SidedFormFactor PointToTriangle(const glm::dvec3& x, const glm::dvec3& n, const 
 
 SidedFormFactor MeanPointToTriangle(const glm::dvec3& centre, const glm::dvec3* xs, int count,
                                     const glm::dvec3& n, const glm::dvec3& a, const glm::dvec3& b,
-                                    const glm::dvec3& c) {
+                                    const glm::dvec3& c, const double* weights) {
     const std::array<glm::dvec3, 3> triangle = {a, b, c};
     SidedFormFactor f;
     const glm::dvec3& x = centre;
     const Clipped upper = ClipAbove(x, n, triangle), lower = ClipAbove(x, -n, triangle);
     for (int k = 0; k < count; ++k) {
-        f.upper += PolygonAbove(xs[k], n, upper.corners.data(), upper.count);
-        f.lower += PolygonAbove(xs[k], -n, lower.corners.data(), lower.count);
+        const double weight = weights ? weights[k] : 1.0 / count;
+        f.upper += weight * PolygonAbove(xs[k], n, upper.corners.data(), upper.count);
+        f.lower += weight * PolygonAbove(xs[k], -n, lower.corners.data(), lower.count);
     }
-    f.upper /= count;
-    f.lower /= count;
     const glm::dvec3 ra = a - x, rb = b - x, rc = c - x;
     const double la = glm::length(ra), lb = glm::length(rb), lc = glm::length(rc);
     if (la > 0.0 && lb > 0.0 && lc > 0.0) {

@@ -20,10 +20,10 @@ SidedFormFactor PointToTriangle(const glm::dvec3& x, const glm::dvec3& n, const 
                                 const glm::dvec3& b, const glm::dvec3& c);
 
 // The form factors of each side averaged over points xs[0..count) of the plane through
-// `centre` of normal n (the triangle clipped by that plane once); the solid angle seen
-// from `centre`.
+// `centre` of normal n (the triangle clipped by that plane once), with weights[0..count)
+// summing to one or, without them, evenly; the solid angle seen from `centre`.
 SidedFormFactor MeanPointToTriangle(const glm::dvec3& centre, const glm::dvec3* xs, int count,
                                     const glm::dvec3& n, const glm::dvec3& a, const glm::dvec3& b,
-                                    const glm::dvec3& c);
+                                    const glm::dvec3& c, const double* weights = nullptr);
 
 }  // namespace leaflux
