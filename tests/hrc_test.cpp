@@ -171,10 +171,10 @@ TEST(HrcViewFactor, MatchesHowellWithinOnePercent) {
     }
 }
 
-// Exact links into a patch take the form factor averaged over three points of it: each
-// point sees a closed cube's other faces with form factors summing to one, so their mean
-// does too (what keeps a closed room's light), and the mean is that of the three points
-// taken one by one.
+// Exact links into a patch take the form factor averaged over three points of it (to
+// judge) or seven weighted ones (to carry light): each point sees a closed cube's other
+// faces with form factors summing to one, so their mean does too (what keeps a closed
+// room's light), and the mean is that of the points taken one by one.
 TEST(FormFactor, MeanOverPointsOfAFaceSumsToOneInsideACube) {
     const glm::dvec3 n(0, 0, 1);  // the floor's triangle, facing in
     const glm::dvec3 a(0.1, 0.1, 0), b(0.9, 0.2, 0), c(0.3, 0.8, 0);
@@ -191,7 +191,20 @@ TEST(FormFactor, MeanOverPointsOfAFaceSumsToOneInsideACube) {
     quad({0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1});
     quad({0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1});
     quad({1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1});
-    double sum = 0.0;
+    // Radon's seven points (degree 5), weighted, as exact links take their transfer.
+    const double r15 = std::sqrt(15.0);
+    const double a1 = (6.0 - r15) / 21.0, a2 = (6.0 + r15) / 21.0;
+    const double w1 = (155.0 - r15) / 1200.0, w2 = (155.0 + r15) / 1200.0;
+    const auto at = [&](double u, double v) { return (1.0 - u - v) * a + u * b + v * c; };
+    const glm::dvec3 seven[7] = {centre,
+                                 at(a1, a1),
+                                 at(1.0 - 2.0 * a1, a1),
+                                 at(a1, 1.0 - 2.0 * a1),
+                                 at(a2, a2),
+                                 at(1.0 - 2.0 * a2, a2),
+                                 at(a2, 1.0 - 2.0 * a2)};
+    const double weights[7] = {9.0 / 40.0, w1, w1, w1, w2, w2, w2};
+    double sum = 0.0, weightedSum = 0.0;
     for (const auto& [p, q, r] : faces) {
         const SidedFormFactor f = MeanPointToTriangle(centre, points, 3, n, p, q, r);
         double oneByOne = 0.0;
@@ -200,8 +213,15 @@ TEST(FormFactor, MeanOverPointsOfAFaceSumsToOneInsideACube) {
         EXPECT_EQ(f.lower, 0.0);
         EXPECT_NEAR(f.solidAngleSr, PointToTriangle(centre, n, p, q, r).solidAngleSr, 1e-12);
         sum += f.upper;
+        const SidedFormFactor g = MeanPointToTriangle(centre, seven, 7, n, p, q, r, weights);
+        double weighted = 0.0;
+        for (int k = 0; k < 7; ++k)
+            weighted += weights[k] * PointToTriangle(seven[k], n, p, q, r).upper;
+        EXPECT_NEAR(g.upper, weighted, 1e-12);
+        weightedSum += g.upper;
     }
     EXPECT_NEAR(sum, 1.0, 1e-9);
+    EXPECT_NEAR(weightedSum, 1.0, 1e-9);
 }
 
 // Hierarchical radiosity does not make form factors sum to one exactly; an excess δ comes
