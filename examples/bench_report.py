@@ -42,7 +42,7 @@ SCENES = {
                   "random canopy, 500 leaves, LAI 3, NIR ρ = τ = 0.45, sun only (HRC's goal: "
                   "1 % L2 in NIR in 0.3 s)",
                   # The goal's scene: a reference of 16,384 paths would add 0.45 % of noise.
-                  ["--reference-samples", "65536", "--hrc-epsilon", "1e-3,2e-4,1e-4,1e-5"]),
+                  ["--reference-samples", "65536", "--hrc-epsilon", "1e-3,3e-4,2e-4,1e-4,1e-5"]),
     "bac1": (None, "Caribu's seedling tray bac1.can (2,270 triangles) under the 46-direction "
                    "overcast sky of Turtle46soc.light",
              ["--reference-samples", "16384", "--hrc-epsilon", "1e-3,1e-4,1e-5"]),

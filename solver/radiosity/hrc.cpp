@@ -840,8 +840,8 @@ class HrcSolver {
     }
 
     // Radon's degree-5 rule on a triangle: its centroid and two orbits of three points,
-    // barycentric (1 − 2α, α, α) with α = (6 ∓ √15)/21, of weights (155 ∓ √15)/1200. Near
-    // exact links take it (EstimateExact).
+    // barycentric (1 − 2α, α, α) with α = (6 ∓ √15)/21, of weights (155 ∓ √15)/1200. Exact
+    // links take their transfer by it (EstimateExact).
     static constexpr std::array<double, 7> kSevenWeights = {
         9.0 / 40.0,          0.12593918054482715, 0.12593918054482715, 0.12593918054482715,
         0.13239415278850618, 0.13239415278850618, 0.13239415278850618};
@@ -1041,7 +1041,7 @@ class HrcSolver {
 
     // Patch ← patch: Lambert's formula per side, averaged over points of R; the solid angle
     // at R's centre. Judging takes three points (the degree-2 rule, barycentric
-    // (2/3, 1/6, 1/6)), the link's transfer seven (`transfer`: Radon's degree-5 rule,
+    // (2/3, 1/6, 1/6)), the link's transfer seven (Points::kTransfer: Radon's degree-5 rule,
     // SevenPoints). F is convex in the distance, so its value at R's centre falls short of
     // R's mean where S is near: on the dense canopy exact links handed on 0.967 of what rays
     // from their senders landed (the audit of then). Three points overshoot where S is near:
@@ -1052,7 +1052,8 @@ class HrcSolver {
     // a closed room they still sum to one: seven points for near links only lost the closed
     // box at ρ = 0.999 3.2 % of its light instead of 1.9 %. The seedling tray's excess at
     // ε = 1e-3 (1.055) is not the rule's.
-    Estimate EstimateExact(std::uint32_t r, std::uint32_t s, bool transfer = false) const {
+    enum class Points { kJudging, kTransfer };
+    Estimate EstimateExact(std::uint32_t r, std::uint32_t s, Points rule = Points::kJudging) const {
         const HrcNode& R = hierarchy_[r];
         const HrcNode& S = hierarchy_[s];
         Estimate e;
@@ -1061,7 +1062,7 @@ class HrcSolver {
         // The form factor at R's centroid speaks for all of R only when R is small against
         // the distance; otherwise parts of R may see S fully (F up to 1 on each side).
         e.near = R.radius > 0.5 * d;
-        if (transfer) {
+        if (rule == Points::kTransfer) {
             const std::array<glm::dvec3, 7> points = SevenPoints(R);
             e.form = MeanPointToTriangle(x, points.data(), 7, R.normal, S.a, S.b, S.c,
                                          kSevenWeights.data());
@@ -1131,7 +1132,7 @@ class HrcSolver {
         }
         // Past that, the form factor by seven points is what the rays, the error and the
         // transfer take.
-        if (exact) e = EstimateExact(r, s, true);
+        if (exact) e = EstimateExact(r, s, Points::kTransfer);
         Verdict verdict;
         const double unoccluded = exact ? e.form.upper + e.form.lower : 0.0;
         const Sight sight = Visibility(r, s, RaySet::kJudging, verdict.rays, unoccluded);
@@ -1250,7 +1251,7 @@ class HrcSolver {
                 if (link->ownRays || LinkError(*link, kWidestSpread) <= threshold) continue;
                 const auto receiver = static_cast<std::uint32_t>(r);
                 Value(receiver, *link,
-                      link->exact ? EstimateExact(receiver, link->sender, true)
+                      link->exact ? EstimateExact(receiver, link->sender, Points::kTransfer)
                                   : EstimatePair(receiver, link->sender),
                       rays);
             }
