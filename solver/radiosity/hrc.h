@@ -43,12 +43,12 @@ struct HrcOptions {
     // one hidden in the cluster gets too much from every such link, an exposed one too
     // little, so on an organ their errors add up where those of links into single patches
     // average out. From the suns and sky cones, such links may carry ε / √(their number);
-    // from surfaces, ε times this. Against 1, 0.3 gives the canopies less error for the
-    // time (the 500-leaf NIR canopy 0.98 % L2 at ε = 2e-4 where 1 gives 1.08 %, for 5 %
-    // more time; the dense canopy at 1e-4 1.76 % where 1 needs 5e-5 and 25 % more time for
-    // 1.78 %), the tray its balance (1.1 % short at 1e-3 instead of 3.1 %), and leaves the
-    // trees and the greenhouse as they were for the time (README, "The hierarchical
-    // radiosity solver").
+    // from surfaces, ε times this. Against 1, 0.3 gave the canopies less error for the
+    // time (the 500-leaf NIR canopy 0.98 % L2 at ε = 2e-4 where 1 gave 1.08 %, for 5 %
+    // more time; the dense canopy at 1e-4 1.76 % where 1 needed 5e-5 and 25 % more time
+    // for 1.78 %), the tray its balance (1.1 % short at 1e-3 instead of 3.1 %), and left
+    // the trees and the greenhouse as they were for the time: measured before exact links
+    // took seven points (README, "The hierarchical radiosity solver").
     double clusterTolerance = 0.3;
     int maxSubdivision = 3;  // a triangle splits into at most 4^this patches
     int visibilityRays = 8;  // per link (stratified pairs of points)
