@@ -833,7 +833,8 @@ class HrcSolver {
     }
 
     // The degree-2 rule's three points of a patch (barycentric (2/3, 1/6, 1/6)), where exact
-    // links take a receiver's form factor (EstimateExact).
+    // links are judged (EstimateExact) and links between planes take a patch receiver's form
+    // factor (PlanePoints).
     static std::array<glm::dvec3, 3> ThreePoints(const HrcNode& p) {
         return {(4.0 * p.a + p.b + p.c) / 6.0, (p.a + 4.0 * p.b + p.c) / 6.0,
                 (p.a + p.b + 4.0 * p.c) / 6.0};

@@ -8,8 +8,9 @@
 // no assumption of flatness; a patch's cosine lobe, interpolated between the directions, is scaled
 // to integrate to π per side as the lobe does. A flat cluster (a leaf of coplanar triangles, a
 // wall) sends and takes light as its plane does, as a patch. A link between two patches uses the
-// analytic point-to-polygon form factor, bounded in the near field, averaged over three points of
-// the receiver; between two planes, one of them a flat cluster, the same over their parts. A
+// analytic point-to-polygon form factor, bounded in the near field, averaged over seven points
+// of the receiver (three to judge it); between two planes, one of them a flat cluster, the
+// same from the sender's parts at three points with the moments of the receiver's area. A
 // cluster hands the light it gathers to its children weighted by how open each is towards it
 // inside the cluster (HrcOptions::exposureRays). Visibility is the unoccluded fraction of
 // deterministic stratified rays through Embree, each ray weighted by the form factor's kernel.
