@@ -840,6 +840,9 @@ class HrcSolver {
                 (p.a + p.b + 4.0 * p.c) / 6.0};
     }
 
+    // Which points of a receiver a link takes its form factor at: those that judge it, or
+    // those that carry its light (ReceiverPoints).
+    enum class Points { kJudging, kTransfer };
     // Radon's degree-5 rule on a triangle: its centroid and two orbits of three points,
     // barycentric (1 − 2α, α, α) with α = (6 ∓ √15)/21, of weights (155 ∓ √15)/1200. Exact
     // links take their transfer by it (EstimateExact).
@@ -918,21 +921,46 @@ class HrcSolver {
         return points;
     }
 
+    // Points of plane r where a link takes its form factor, with their weights: a patch's
+    // three (ThreePoints) to judge a link and Radon's seven (SevenPoints) to carry its
+    // light, the same for every link into it, so that in a closed room they sum to one; a
+    // flat cluster's three with the moments of its area (PlanePoints).
+    struct Quadrature {
+        std::array<glm::dvec3, 7> points;
+        std::array<double, 7> weights;
+        int count = 0;
+    };
+    Quadrature ReceiverPoints(std::uint32_t r, Points rule) const {
+        Quadrature q;
+        if (hierarchy_[r].patch && rule == Points::kTransfer) {
+            q.points = SevenPoints(hierarchy_[r]);
+            q.weights = kSevenWeights;
+            q.count = 7;
+            return q;
+        }
+        const std::array<glm::dvec3, 3> three = PlanePoints(r);
+        std::copy(three.begin(), three.end(), q.points.begin());
+        q.weights.fill(1.0 / 3.0);
+        q.count = 3;
+        return q;
+    }
+
     // Plane ← plane, one of them a flat cluster: Lambert's formula per side of R from each of
     // S's patches (its parts that are clusters as points), at R's three points (PlanePoints).
     // Light from a sender reaching across R's plane lands on the side it reaches: taken with
     // one cosine towards S's centre, the 30-leaf closed box's links between flat clusters
     // handed on 0.84 of what rays from their receivers find and at ρ = 0.999 the box lost
     // 3.1 % of the lamp's light; so taken, 0.98 and 1.9 %.
-    SidedFormFactor PlanesForm(std::uint32_t r, std::uint32_t s) const {
+    SidedFormFactor PlanesForm(std::uint32_t r, std::uint32_t s, Points rule) const {
         const HrcNode& R = hierarchy_[r];
-        const std::array<glm::dvec3, 3> points = PlanePoints(r);
+        const Quadrature q = ReceiverPoints(r, rule);
         SidedFormFactor form;
         for (std::uint32_t part : PlaneParts(s)) {
             const HrcNode& P = hierarchy_[part];
             SidedFormFactor f;
             if (P.patch) {
-                f = MeanPointToTriangle(R.centroid, points.data(), 3, R.normal, P.a, P.b, P.c);
+                f = MeanPointToTriangle(R.centroid, q.points.data(), q.count, R.normal, P.a, P.b,
+                                        P.c, q.weights.data());
             } else {
                 f.solidAngleSr = PartSolidAngle(part, R.centroid);
                 const double cosine = glm::dot(R.normal, glm::normalize(P.centroid - R.centroid));
@@ -946,7 +974,7 @@ class HrcSolver {
         return form;
     }
 
-    Estimate EstimatePair(std::uint32_t r, std::uint32_t s) const {
+    Estimate EstimatePair(std::uint32_t r, std::uint32_t s, Points rule = Points::kJudging) const {
         const HrcNode& R = hierarchy_[r];
         const HrcNode& S = hierarchy_[s];
         Estimate e;
@@ -959,7 +987,7 @@ class HrcSolver {
             e.geometricError =
                 std::min(1.0, std::pow((R.radius + S.radius) / std::max(d, 1e-300), 2.0));
             if (Planar(r)) {
-                e.form = PlanesForm(r, s);
+                e.form = PlanesForm(r, s, rule);
                 e.sided = true;
                 // Near, any part of R may see S whole; but no more than S sends from a side.
                 e.reach = std::min(
@@ -1049,11 +1077,11 @@ class HrcSolver {
     // on the 500-leaf canopy at ε = 2e-4 they handed on 1.0077 of what rays from the
     // receivers find (AuditLinks), on the dense canopy at 1e-4 1.0064, and seven points
     // 1.0006 and 1.0012; the 500-leaf canopy's NIR L2 error at 3e-4 went from 1.06 to
-    // 0.97 %, for 14 % more time. Every exact link into R takes the same points, so that in
-    // a closed room they still sum to one: seven points for near links only lost the closed
-    // box at ρ = 0.999 3.2 % of its light instead of 1.9 %. The seedling tray's excess at
+    // 0.97 %, for 14 % more time. Every link into R carries light by the same points
+    // (ReceiverPoints), so that in a closed room they still sum to one: seven points for
+    // near exact links only lost the closed box at ρ = 0.999 3.2 % of its light instead of
+    // 1.9 %. The seedling tray's excess at
     // ε = 1e-3 (1.055) is not the rule's.
-    enum class Points { kJudging, kTransfer };
     Estimate EstimateExact(std::uint32_t r, std::uint32_t s, Points rule = Points::kJudging) const {
         const HrcNode& R = hierarchy_[r];
         const HrcNode& S = hierarchy_[s];
@@ -1063,14 +1091,9 @@ class HrcSolver {
         // The form factor at R's centroid speaks for all of R only when R is small against
         // the distance; otherwise parts of R may see S fully (F up to 1 on each side).
         e.near = R.radius > 0.5 * d;
-        if (rule == Points::kTransfer) {
-            const std::array<glm::dvec3, 7> points = SevenPoints(R);
-            e.form = MeanPointToTriangle(x, points.data(), 7, R.normal, S.a, S.b, S.c,
-                                         kSevenWeights.data());
-        } else {
-            const std::array<glm::dvec3, 3> points = ThreePoints(R);
-            e.form = MeanPointToTriangle(x, points.data(), 3, R.normal, S.a, S.b, S.c);
-        }
+        const Quadrature q = ReceiverPoints(r, rule);
+        e.form = MeanPointToTriangle(x, q.points.data(), q.count, R.normal, S.a, S.b, S.c,
+                                     q.weights.data());
         e.senderSide = glm::dot(S.normal, x - y) >= 0.0 ? kUpper : kLower;
         e.toSender = glm::normalize(y - x);
         if (S.areaM2 < R.areaM2 / 16.0) {
@@ -1131,9 +1154,10 @@ class HrcSolver {
             if (const auto split = SplitChoice(r, s); split != Verdict::kNone)
                 return {split, {}, 0.0f, 0};
         }
-        // Past that, the form factor by seven points is what the rays, the error and the
-        // transfer take.
-        if (exact) e = EstimateExact(r, s, Points::kTransfer);
+        // Past that, the form factor at the points that carry light (ReceiverPoints) is what
+        // the rays, the error and the transfer take.
+        if (hierarchy_[r].patch && exact) e = EstimateExact(r, s, Points::kTransfer);
+        if (hierarchy_[r].patch && e.sided) e = EstimatePair(r, s, Points::kTransfer);
         Verdict verdict;
         const double unoccluded = exact ? e.form.upper + e.form.lower : 0.0;
         const Sight sight = Visibility(r, s, RaySet::kJudging, verdict.rays, unoccluded);
@@ -1253,7 +1277,7 @@ class HrcSolver {
                 const auto receiver = static_cast<std::uint32_t>(r);
                 Value(receiver, *link,
                       link->exact ? EstimateExact(receiver, link->sender, Points::kTransfer)
-                                  : EstimatePair(receiver, link->sender),
+                                  : EstimatePair(receiver, link->sender, Points::kTransfer),
                       rays);
             }
             valueRays += rays;
