@@ -68,7 +68,7 @@ Solution SolveAndRecord(const PreparedScene& prepared, const SolverSettings& set
 // is counted by rays apart from the links, with a standard error of its own: the bound is
 // `hrcBound` of the incident power plus 4.6 of those standard errors. At ε = 1e-5 the
 // balance closes to 0.5 % on open, mildly scattering scenes, for leaves 1 µm apart
-// (measured at 0.14 ± 0.44 %) and in the dense canopies (−0.44 to −0.60 %, ± 0.2 %), and
+// (measured at 0.14 ± 0.44 %) and in the dense canopies (−0.44 to −0.58 %, ± 0.2 %), and
 // is measured at 0.25–1.9 % in the closed boxes at ε = 1e-6: `hrcBound` is set by each
 // test, never above 5 %.
 void ExpectBalanced(const Solution& solution, SolverKind kind, double hrcBound = 5e-3) {

@@ -844,8 +844,8 @@ class HrcSolver {
     // those that carry its light (ReceiverPoints).
     enum class Points { kJudging, kTransfer };
     // Radon's degree-5 rule on a triangle: its centroid and two orbits of three points,
-    // barycentric (1 − 2α, α, α) with α = (6 ∓ √15)/21, of weights (155 ∓ √15)/1200. Exact
-    // links take their transfer by it (EstimateExact).
+    // barycentric (1 − 2α, α, α) with α = (6 ∓ √15)/21, of weights (155 ∓ √15)/1200. Links
+    // into a patch carry light by it (ReceiverPoints).
     static constexpr std::array<double, 7> kSevenWeights = {
         9.0 / 40.0,          0.12593918054482715, 0.12593918054482715, 0.12593918054482715,
         0.13239415278850618, 0.13239415278850618, 0.13239415278850618};
@@ -946,7 +946,7 @@ class HrcSolver {
     }
 
     // Plane ← plane, one of them a flat cluster: Lambert's formula per side of R from each of
-    // S's patches (its parts that are clusters as points), at R's three points (PlanePoints).
+    // S's patches (its parts that are clusters as points), at R's points (ReceiverPoints).
     // Light from a sender reaching across R's plane lands on the side it reaches: taken with
     // one cosine towards S's centre, the 30-leaf closed box's links between flat clusters
     // handed on 0.84 of what rays from their receivers find and at ρ = 0.999 the box lost
@@ -1080,17 +1080,12 @@ class HrcSolver {
     // 0.97 %, for 14 % more time. Every link into R carries light by the same points
     // (ReceiverPoints), so that in a closed room they still sum to one: seven points for
     // near exact links only lost the closed box at ρ = 0.999 3.2 % of its light instead of
-    // 1.9 %. The seedling tray's excess at
-    // ε = 1e-3 (1.055) is not the rule's.
+    // 1.9 %. The seedling tray's excess at ε = 1e-3 (1.055) is not the rule's.
     Estimate EstimateExact(std::uint32_t r, std::uint32_t s, Points rule = Points::kJudging) const {
         const HrcNode& R = hierarchy_[r];
         const HrcNode& S = hierarchy_[s];
         Estimate e;
         const glm::dvec3 x = (R.a + R.b + R.c) / 3.0, y = (S.a + S.b + S.c) / 3.0;
-        const double d = std::max(glm::length(S.centroid - R.centroid), 1e-300);
-        // The form factor at R's centroid speaks for all of R only when R is small against
-        // the distance; otherwise parts of R may see S fully (F up to 1 on each side).
-        e.near = R.radius > 0.5 * d;
         const Quadrature q = ReceiverPoints(r, rule);
         e.form = MeanPointToTriangle(x, q.points.data(), q.count, R.normal, S.a, S.b, S.c,
                                      q.weights.data());
@@ -1119,6 +1114,10 @@ class HrcSolver {
         if (Inner(R.triangle, kUpper)) e.form.upper = 0.0;
         if (Inner(R.triangle, kLower)) e.form.lower = 0.0;
         if (unhidden > 0.0) e.form.solidAngleSr *= (e.form.upper + e.form.lower) / unhidden;
+        const double d = std::max(glm::length(S.centroid - R.centroid), 1e-300);
+        // The form factor at R's centroid speaks for all of R only when R is small against
+        // the distance; otherwise parts of R may see S fully (F up to 1 on each side).
+        e.near = R.radius > 0.5 * d;
         const double radiosity = SideRadiosity(s, e.senderSide);
         e.reach = (e.near ? 1.0 : e.form.upper + e.form.lower) * R.areaM2;
         e.power = radiosity * e.reach;
@@ -1156,8 +1155,11 @@ class HrcSolver {
         }
         // Past that, the form factor at the points that carry light (ReceiverPoints) is what
         // the rays, the error and the transfer take.
-        if (hierarchy_[r].patch && exact) e = EstimateExact(r, s, Points::kTransfer);
-        if (hierarchy_[r].patch && e.sided) e = EstimatePair(r, s, Points::kTransfer);
+        if (exact) {
+            e = EstimateExact(r, s, Points::kTransfer);
+        } else if (e.sided && hierarchy_[r].patch) {
+            e = EstimatePair(r, s, Points::kTransfer);
+        }
         Verdict verdict;
         const double unoccluded = exact ? e.form.upper + e.form.lower : 0.0;
         const Sight sight = Visibility(r, s, RaySet::kJudging, verdict.rays, unoccluded);
