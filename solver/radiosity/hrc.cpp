@@ -910,12 +910,19 @@ class HrcSolver {
                 uu += weight * a * a, uv += weight * a * b, vv += weight * b * b;
             }
         }
+        static const std::array<glm::dvec2, 3> kUnitCovariance = [] {
+            std::array<glm::dvec2, 3> unit;
+            for (int k = 0; k < 3; ++k) {
+                const double angle = kPi / 2.0 + k * 2.0 * kPi / 3.0;
+                unit[k] = std::sqrt(2.0) * glm::dvec2(std::cos(angle), std::sin(angle));
+            }
+            return unit;
+        }();
         const double l11 = std::sqrt(uu), l21 = l11 > 0.0 ? uv / l11 : 0.0;
         const double l22 = std::sqrt(std::max(vv - l21 * l21, 0.0));
         std::array<glm::dvec3, 3> points;
         for (int k = 0; k < 3; ++k) {
-            const double angle = kPi / 2.0 + k * 2.0 * kPi / 3.0;
-            const double x = std::sqrt(2.0) * std::cos(angle), y = std::sqrt(2.0) * std::sin(angle);
+            const auto [x, y] = kUnitCovariance[k];
             points[k] = R.centroid + l11 * x * u + (l21 * x + l22 * y) * v;
         }
         return points;
