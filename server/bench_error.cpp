@@ -12,11 +12,11 @@
 #include <optional>
 
 #include "server/scene_proto.h"
-#include "solver/accuracy.h"
-#include "solver/error.h"
-#include "solver/export.h"
-#include "solver/memory.h"
+#include "solver/results/accuracy.h"
+#include "solver/results/export.h"
 #include "solver/solve.h"
+#include "solver/util/error.h"
+#include "solver/util/memory.h"
 
 namespace leaflux {
 namespace {

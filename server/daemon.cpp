@@ -6,7 +6,7 @@
 #include <chrono>
 
 #include "server/executor.h"
-#include "solver/error.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 namespace {

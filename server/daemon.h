@@ -17,7 +17,7 @@
 
 #include "leaflux.pb.h"
 #include "server/scene_proto.h"
-#include "solver/scene_store.h"
+#include "solver/scene/scene_store.h"
 #include "solver/solve.h"
 
 namespace leaflux {

@@ -15,10 +15,10 @@
 #include "server/bench_error.h"
 #include "server/client.h"
 #include "server/scene_proto.h"
-#include "solver/error.h"
-#include "solver/export.h"
-#include "solver/generator.h"
+#include "solver/generate/generator.h"
+#include "solver/results/export.h"
 #include "solver/solve.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 namespace {

@@ -4,8 +4,8 @@
 #include <set>
 
 #include "server/scene_proto.h"
-#include "solver/error.h"
-#include "solver/importers.h"
+#include "solver/io/importers.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 namespace {

@@ -9,8 +9,8 @@
 #include <sstream>
 
 #include "server/text_format.h"
-#include "solver/error.h"
-#include "solver/importers.h"
+#include "solver/io/importers.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 namespace {

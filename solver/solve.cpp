@@ -1,6 +1,6 @@
 #include "solver/solve.h"
 
-#include "solver/error.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 

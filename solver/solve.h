@@ -4,10 +4,10 @@
 #include <memory>
 #include <string>
 
-#include "solver/light.h"
 #include "solver/radiosity/hrc.h"
-#include "solver/raytrace.h"
-#include "solver/reference.h"
+#include "solver/raytrace/raytrace.h"
+#include "solver/reference/reference.h"
+#include "solver/results/light.h"
 
 namespace leaflux {
 

@@ -1,12 +1,12 @@
-// The accuracy figures of `leaflux bench error` (solver/accuracy.h): by hand on a small
+// The accuracy figures of `leaflux bench error` (solver/results/accuracy.h): by hand on a small
 // scene, and the reference floor against the spread of two Monte Carlo solutions.
-#include "solver/accuracy.h"
+#include "solver/results/accuracy.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "solver/generator.h"
+#include "solver/generate/generator.h"
 #include "solver/solve.h"
 #include "tests/scene_builders.h"
 

@@ -5,9 +5,9 @@
 
 #include <cmath>
 
-#include "solver/importers.h"
-#include "solver/sampling.h"
+#include "solver/io/importers.h"
 #include "solver/solve.h"
+#include "solver/util/sampling.h"
 #include "tests/scene_builders.h"
 
 namespace leaflux {

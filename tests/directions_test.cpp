@@ -1,4 +1,4 @@
-#include "solver/directions.h"
+#include "solver/util/directions.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <limits>
 #include <numbers>
 
-#include "solver/sampling.h"
+#include "solver/util/sampling.h"
 
 namespace leaflux {
 namespace {

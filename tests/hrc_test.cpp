@@ -5,11 +5,11 @@
 #include <cmath>
 #include <tuple>
 
-#include "solver/accuracy.h"
-#include "solver/error.h"
-#include "solver/generator.h"
+#include "solver/generate/generator.h"
 #include "solver/radiosity/form_factor.h"
+#include "solver/results/accuracy.h"
 #include "solver/solve.h"
+#include "solver/util/error.h"
 #include "tests/scene_builders.h"
 
 namespace leaflux {

@@ -1,5 +1,5 @@
 // Every importer on the files of ../shared/data, and on broken files.
-#include "solver/importers.h"
+#include "solver/io/importers.h"
 
 #include <gtest/gtest.h>
 
@@ -7,8 +7,8 @@
 #include <fstream>
 #include <set>
 
-#include "solver/error.h"
-#include "solver/scene.h"
+#include "solver/scene/scene.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 namespace {

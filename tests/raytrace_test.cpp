@@ -1,4 +1,4 @@
-#include "solver/raytrace.h"
+#include "solver/raytrace/raytrace.h"
 
 #include <gtest/gtest.h>
 

@@ -4,7 +4,7 @@
 // t with kReplicates − 1 degrees of freedom: kSigmas is its two-sided 1e-4 quantile. Where
 // geometry only approximates the closed form (a 256-gon for a disc) the bound adds that
 // error, stated.
-#include "solver/reference.h"
+#include "solver/reference/reference.h"
 
 #include <gtest/gtest.h>
 

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "solver/light.h"
-#include "solver/scene.h"
+#include "solver/results/light.h"
+#include "solver/scene/scene.h"
 
 namespace leaflux::testing {
 

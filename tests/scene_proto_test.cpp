@@ -8,8 +8,8 @@
 #include <fstream>
 #include <set>
 
-#include "solver/error.h"
-#include "solver/generator.h"
+#include "solver/generate/generator.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 namespace {

@@ -8,10 +8,10 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 
-#include "solver/error.h"
-#include "solver/generator.h"
-#include "solver/geometry.h"
-#include "solver/scene_store.h"
+#include "solver/generate/generator.h"
+#include "solver/scene/geometry.h"
+#include "solver/scene/scene_store.h"
+#include "solver/util/error.h"
 #include "tests/scene_builders.h"
 
 namespace leaflux {

@@ -1,4 +1,4 @@
-#include "solver/sources.h"
+#include "solver/sources/sources.h"
 
 #include <gtest/gtest.h>
 

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "solver/directions.h"
-#include "solver/generator.h"
+#include "solver/generate/generator.h"
 #include "solver/solve.h"
+#include "solver/util/directions.h"
 #include "tests/scene_builders.h"
 
 namespace leaflux {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <glm/gtc/constants.hpp>
 
-#include "solver/directions.h"
+#include "solver/util/directions.h"
 
 namespace leaflux {
 namespace {

@@ -5,7 +5,7 @@
 #include <limits>
 #include <unordered_map>
 
-#include "solver/check.h"
+#include "solver/util/check.h"
 
 namespace leaflux {
 namespace {

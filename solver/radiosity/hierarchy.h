@@ -13,8 +13,8 @@
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "solver/geometry.h"
-#include "solver/sampling.h"
+#include "solver/scene/geometry.h"
+#include "solver/util/sampling.h"
 
 namespace leaflux {
 

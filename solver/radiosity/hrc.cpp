@@ -16,12 +16,12 @@
 #include <span>
 #include <unordered_map>
 
-#include "solver/check.h"
-#include "solver/directions.h"
-#include "solver/memory.h"
 #include "solver/radiosity/form_factor.h"
 #include "solver/radiosity/hierarchy.h"
-#include "solver/sampling.h"
+#include "solver/util/check.h"
+#include "solver/util/directions.h"
+#include "solver/util/memory.h"
+#include "solver/util/sampling.h"
 
 namespace leaflux {
 namespace {

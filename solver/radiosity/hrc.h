@@ -32,8 +32,8 @@
 
 #include <cstdint>
 
-#include "solver/light.h"
-#include "solver/raytrace.h"
+#include "solver/raytrace/raytrace.h"
+#include "solver/results/light.h"
 
 namespace leaflux {
 

@@ -17,7 +17,7 @@
 #include "server/daemon.h"
 #include "server/executor.h"
 #include "server/transport.h"
-#include "solver/generator.h"
+#include "solver/generate/generator.h"
 
 namespace leaflux {
 namespace {

@@ -8,9 +8,9 @@
 #include <benchmark/benchmark.h>
 #include <tbb/parallel_for.h>
 
-#include "solver/generator.h"
-#include "solver/sampling.h"
+#include "solver/generate/generator.h"
 #include "solver/solve.h"
+#include "solver/util/sampling.h"
 
 namespace leaflux {
 namespace {

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <fstream>
 
-#include "solver/generator.h"
+#include "solver/generate/generator.h"
 #include "solver/solve.h"
 
 namespace leaflux {

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "solver/scene.h"
+#include "solver/scene/scene.h"
 
 namespace leaflux {
 

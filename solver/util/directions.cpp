@@ -1,4 +1,4 @@
-#include "solver/directions.h"
+#include "solver/util/directions.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <numbers>
 #include <utility>
 
-#include "solver/check.h"
+#include "solver/util/check.h"
 
 namespace leaflux {
 namespace {

@@ -1,9 +1,9 @@
-#include "solver/scene_store.h"
+#include "solver/scene/scene_store.h"
 
 #include <algorithm>
 
-#include "solver/check.h"
-#include "solver/error.h"
+#include "solver/util/check.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 

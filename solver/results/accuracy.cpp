@@ -1,10 +1,10 @@
-#include "solver/accuracy.h"
+#include "solver/results/accuracy.h"
 
 #include <algorithm>
 #include <cmath>
 #include <unordered_set>
 
-#include "solver/check.h"
+#include "solver/util/check.h"
 
 namespace leaflux {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "solver/geometry.h"
+#include "solver/scene/geometry.h"
 
 namespace leaflux {
 

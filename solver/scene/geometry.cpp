@@ -1,4 +1,4 @@
-#include "solver/geometry.h"
+#include "solver/scene/geometry.h"
 
 #include <limits>
 

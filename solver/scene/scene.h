@@ -16,7 +16,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "solver/sources.h"
+#include "solver/sources/sources.h"
 
 namespace leaflux {
 

@@ -1,10 +1,10 @@
-#include "solver/light.h"
+#include "solver/results/light.h"
 
 #include <chrono>
 #include <cmath>
 #include <unordered_map>
 
-#include "solver/memory.h"
+#include "solver/util/memory.h"
 
 namespace leaflux {
 

@@ -4,8 +4,8 @@
 
 #include <vector>
 
-#include "solver/light.h"
-#include "solver/scene.h"
+#include "solver/results/light.h"
+#include "solver/scene/scene.h"
 
 namespace leaflux {
 

@@ -1,4 +1,4 @@
-#include "solver/scene.h"
+#include "solver/scene/scene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "solver/error.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 namespace {

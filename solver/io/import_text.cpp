@@ -5,8 +5,8 @@
 #include <map>
 #include <sstream>
 
-#include "solver/error.h"
-#include "solver/importers.h"
+#include "solver/io/importers.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 namespace {

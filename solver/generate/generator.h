@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "solver/scene.h"
+#include "solver/scene/scene.h"
 
 namespace leaflux {
 

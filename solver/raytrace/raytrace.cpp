@@ -1,4 +1,4 @@
-#include "solver/raytrace.h"
+#include "solver/raytrace/raytrace.h"
 
 #include <pmmintrin.h>
 #include <xmmintrin.h>
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "solver/check.h"
+#include "solver/util/check.h"
 
 namespace leaflux {
 namespace {

@@ -15,7 +15,7 @@
 #include <optional>
 #include <vector>
 
-#include "solver/geometry.h"
+#include "solver/scene/geometry.h"
 
 namespace leaflux {
 

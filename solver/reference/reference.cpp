@@ -1,4 +1,4 @@
-#include "solver/reference.h"
+#include "solver/reference/reference.h"
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -12,9 +12,9 @@
 #include <numeric>
 #include <unordered_map>
 
-#include "solver/check.h"
-#include "solver/memory.h"
-#include "solver/sampling.h"
+#include "solver/util/check.h"
+#include "solver/util/memory.h"
+#include "solver/util/sampling.h"
 
 namespace leaflux {
 namespace {

@@ -1,12 +1,12 @@
-#include "solver/sources.h"
+#include "solver/sources/sources.h"
 
 #include <array>
 #include <cmath>
 #include <glm/gtc/constants.hpp>
 #include <mutex>
 
-#include "solver/check.h"
-#include "solver/directions.h"
+#include "solver/util/check.h"
+#include "solver/util/directions.h"
 
 namespace leaflux {
 namespace {

@@ -16,8 +16,8 @@
 #include <utility>
 #include <vector>
 
-#include "solver/geometry.h"
-#include "solver/scene.h"
+#include "solver/scene/geometry.h"
+#include "solver/scene/scene.h"
 
 namespace leaflux {
 

@@ -1,13 +1,13 @@
-#include "solver/generator.h"
+#include "solver/generate/generator.h"
 
 #include <algorithm>
 #include <cmath>
 #include <glm/gtc/constants.hpp>
 
-#include "solver/check.h"
-#include "solver/error.h"
-#include "solver/geometry.h"
-#include "solver/sampling.h"
+#include "solver/scene/geometry.h"
+#include "solver/util/check.h"
+#include "solver/util/error.h"
+#include "solver/util/sampling.h"
 
 namespace leaflux {
 namespace {

@@ -1,4 +1,4 @@
-#include "solver/export.h"
+#include "solver/results/export.h"
 
 #include <cstdio>
 #include <sstream>

@@ -1,4 +1,4 @@
-#include "solver/error.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 namespace {

@@ -16,9 +16,9 @@
 #include <cstdint>
 #include <functional>
 
-#include "solver/light.h"
-#include "solver/raytrace.h"
-#include "solver/scene.h"
+#include "solver/raytrace/raytrace.h"
+#include "solver/results/light.h"
+#include "solver/scene/scene.h"
 
 namespace leaflux {
 

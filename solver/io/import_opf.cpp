@@ -9,8 +9,8 @@
 #include <memory>
 #include <sstream>
 
-#include "solver/error.h"
-#include "solver/importers.h"
+#include "solver/io/importers.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 namespace {

@@ -1,4 +1,4 @@
-#include "solver/memory.h"
+#include "solver/util/memory.h"
 
 #include <malloc.h>
 #include <sys/resource.h>

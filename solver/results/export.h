@@ -5,7 +5,7 @@
 #include <ostream>
 #include <string>
 
-#include "solver/light.h"
+#include "solver/results/light.h"
 
 namespace leaflux {
 
