@@ -28,6 +28,13 @@
 // iterated until the change still to come is below the tolerance; between solutions every link is
 // judged again with the light found (refine–solve passes), so that senders dark when first linked
 // are refined too.
+//
+// The engine is a set of units, each in its own file, that this whole-scene driver (hrc.cpp)
+// runs and that other drivers reuse: hierarchy (cluster creation), node_model (what each node
+// answers), quadrature and estimate (form factors, transfers, geometric error), visibility,
+// exposure, refinement (linking, judging, splitting, judging again), traversal and push_pull,
+// gathering (sweeps and convergence), outputs and link_audit; channels and light_state hold
+// the per-node light of a run-time number of channels (bands × beams).
 #pragma once
 
 #include <cstdint>
@@ -58,7 +65,7 @@ struct HrcOptions {
     int sourceRays = 32;
     int directionLevel = 2;  // direction set of cluster light: 2 → 34 directions
     // A cluster hands the light it gathers to its children weighted by how open each is
-    // towards the light within the cluster (HrcSolver::FindExposures): rays per child and
+    // towards the light within the cluster (exposure.h): rays per child and
     // direction of the 10-direction set. 0: evenly by area facing the light, as the clusters
     // of Sillion 1995. It costs 80 short rays per node: 2–5 % of the 500-leaf canopy's time,
     // 10–20 % of the 10k tree's, whose error it leaves as it was (README).

@@ -1,0 +1,50 @@
+// Exposure: how open each child of a cluster is towards the light the cluster gathers.
+// A cluster hands the light it gathers from a direction to its children by their area
+// facing it, as though none shaded another: the organs deep in a crown or a canopy get as
+// much as the exposed ones. Each child c of a cluster C (not flat) takes instead its share
+// weighted by e_c(ω), the fraction of its area facing ω that C's own triangles leave open
+// towards ω, over the mean of e over C's children: the light C gathers is all handed down.
+// e is found by rays from c's points towards each direction of the 10-direction set and
+// interpolated to the cluster light's set (with 34 directions of their own, the 10k tree
+// took 30 % longer for an error 2.02 → 1.97 % instead of 2.01 %). On the 500-leaf NIR
+// canopy at ε = 1e-4 the NIR L2 error went from 0.985 to 0.911 %, on the dense canopy from
+// 2.21 to 2.02 %. Owns its table; reads the hierarchy and the node model.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "solver/radiosity/node_model.h"
+#include "solver/raytrace/raytrace.h"
+
+namespace leaflux {
+
+class Exposure {
+  public:
+    // No exposure: every child takes its share by area.
+    Exposure() = default;
+    // `raysPerDirection` rays from each child of every cluster (not flat) towards each
+    // direction of the 10-direction set (fewer when the cluster light's set is coarser).
+    Exposure(const NodeModel& model, const RayScene& scene, int raysPerDirection);
+
+    // Whether node n takes a share of its parent's light by exposure: a node the hierarchy
+    // was built with, under a cluster that is not flat.
+    bool Exposed(std::uint32_t n) const {
+        const std::uint32_t parent = model_ ? model_->Nodes()[n].parent : kNoNode;
+        return n < nodes_ && parent != kNoNode && !model_->Planar(parent);
+    }
+    // Per bin of the cluster light's set, the factor on node n's share of its parent's light.
+    const float* Share(std::uint32_t n) const {
+        return &share_[static_cast<std::size_t>(n) * bins_];
+    }
+    std::int64_t Rays() const { return traced_; }
+
+  private:
+    const NodeModel* model_ = nullptr;
+    std::size_t nodes_ = 0;
+    int bins_ = 0;
+    std::vector<float> share_;  // [node as built][bin]
+    std::int64_t traced_ = 0;
+};
+
+}  // namespace leaflux

@@ -1,0 +1,289 @@
+#include "solver/radiosity/push_pull.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+namespace leaflux {
+namespace {
+constexpr double kPi = glm::pi<double>();
+}  // namespace
+
+void PushPull::PullUp(Field& field) const {
+    // Children before parents: the subtrees in parallel (each a pre-order range of its
+    // own), then the nodes above them.
+    field.emitted.resize(hierarchy_.Size(), 0.0);
+    const auto& preOrder = traversal_.PreOrder();
+    const auto& subtrees = traversal_.Subtrees();
+    tbb::parallel_for(std::size_t{0}, subtrees.size(), [&](std::size_t t) {
+        for (std::size_t i = subtrees[t].second; i-- > subtrees[t].first;)
+            PullNode(field, preOrder[i]);
+    });
+    const auto& above = traversal_.Above();
+    for (auto it = above.rbegin(); it != above.rend(); ++it) PullNode(field, *it);
+}
+
+void PushPull::PullNode(Field& field, std::uint32_t n) const {
+    const HrcNode& node = hierarchy_[n];
+    const Channels& set = model_.ChannelSet();
+    const int channels = set.Count();
+    double& emitted = field.emitted[n];
+    emitted = 0.0;
+    if (node.patch && node.children.empty()) {
+        const double* upper = field.radiosity(n, kUpper);
+        const double* lower = field.radiosity(n, kLower);
+        if (set.measure == ChannelMeasure::kSum || set.beams == 1) {
+            for (int c = 0; c < channels; ++c) emitted += node.areaM2 * (upper[c] + lower[c]);
+        } else {
+            thread_local std::vector<double> power;
+            power.resize(channels);
+            for (int c = 0; c < channels; ++c) power[c] = node.areaM2 * (upper[c] + lower[c]);
+            emitted = set.Measure(power.data());
+        }
+        return;
+    }
+    // A cluster's children may be brightest under different beams: their sum bounds it.
+    for (std::uint32_t child : node.children) emitted += field.emitted[child];
+    if (model_.Planar(n)) {
+        // A split patch or a flat cluster radiates the area mean of its parts; a flat
+        // cluster's intensity, below, is for the clusters above it.
+        for (int s : {kUpper, kLower}) {
+            double* mean = field.radiosity(n, s);
+            std::fill_n(mean, channels, 0.0);
+            for (std::uint32_t child : node.children) {
+                const double share = hierarchy_[child].areaM2 / node.areaM2;
+                const double* part = field.radiosity(child, s);
+                for (int c = 0; c < channels; ++c) mean[c] += share * part[c];
+            }
+        }
+        if (node.patch) return;
+    }
+    const int bins = model_.BinCount();
+    double* out = field.intensity[model_.Slot(n)];
+    std::fill(out, out + bins * channels, 0.0);
+    for (std::uint32_t child : node.children) {
+        const HrcNode& c = hierarchy_[child];
+        if (!c.patch) {
+            const double* in = field.intensity[model_.Slot(child)];
+            for (int i = 0; i < bins * channels; ++i) out[i] += in[i];
+            continue;
+        }
+        for (int d = 0; d < bins; ++d) {
+            const auto [side, lobe] = model_.BinCosine(c, d);
+            const double scale = c.areaM2 * lobe / kPi;
+            const double* radiosity = field.radiosity(child, side);
+            for (int k = 0; k < channels; ++k) out[d * channels + k] += scale * radiosity[k];
+        }
+    }
+}
+
+template <class Holds, class Add, class Top>
+void PushPull::DescendAll(std::size_t width, Holds holds, Add add, Top top) const {
+    const auto& preOrder = traversal_.PreOrder();
+    const auto& subtrees = traversal_.Subtrees();
+    tbb::parallel_for(std::size_t{0}, subtrees.size(), [&](std::size_t t) {
+        const std::uint32_t start = preOrder[subtrees[t].first];
+        std::vector<double> above(width, 0.0);
+        std::vector<std::uint32_t> chain;  // handed down from the root, as Descend does
+        for (std::uint32_t m = hierarchy_[start].parent; m != kNoNode; m = hierarchy_[m].parent) {
+            if (holds(m)) chain.push_back(m);
+        }
+        for (auto m = chain.rbegin(); m != chain.rend(); ++m) add(*m, above);
+        Scratch scratch;
+        Descend(start, above, holds, add, top, scratch);
+    });
+}
+
+template <class Holds, class Add, class Top>
+void PushPull::Descend(std::uint32_t start, const std::vector<double>& above, Holds holds, Add add,
+                       Top top, Scratch& scratch) const {
+    // Depth-first; sums[k] is written only by a node of depth k that holds something, and
+    // read by its descendants, so a sibling's subtree never overwrites a sum still in use.
+    struct Entry {
+        std::uint32_t node;
+        int depth, sum;
+    };
+    std::vector<std::vector<double>> sums = {above};
+    std::vector<Entry> stack = {{start, 1, 0}};
+    while (!stack.empty()) {
+        const Entry entry = stack.back();
+        stack.pop_back();
+        int sum = entry.sum;
+        if (holds(entry.node)) {
+            if (static_cast<int>(sums.size()) <= entry.depth) sums.resize(entry.depth + 1);
+            sums[entry.depth] = sums[entry.sum];
+            add(entry.node, sums[entry.depth]);
+            sum = entry.depth;
+        }
+        const HrcNode& node = hierarchy_[entry.node];
+        if (node.patch) {
+            top(entry.node, sums[sum], scratch);
+            continue;
+        }
+        for (std::uint32_t child : node.children) stack.push_back({child, entry.depth + 1, sum});
+    }
+}
+
+template <class Holds, class Add, class Leaf>
+void PushPull::DescendPatches(std::uint32_t t, const std::vector<double>& value,
+                              std::deque<std::vector<double>>& levels, std::size_t level,
+                              Holds holds, Add add, Leaf leaf) const {
+    const HrcNode& node = hierarchy_[t];
+    if (node.children.empty()) return leaf(t, value);
+    for (std::uint32_t child : node.children) {
+        if (!holds(child)) {
+            DescendPatches(child, value, levels, level, holds, add, leaf);
+            continue;
+        }
+        if (levels.size() <= level) levels.resize(level + 1);
+        std::vector<double>& below = levels[level];
+        below = value;
+        add(child, below);
+        DescendPatches(child, below, levels, level + 1, holds, add, leaf);
+    }
+}
+
+void PushPull::PushSources(const Links& links, const std::vector<DirectionalSource>& sources,
+                           SourceLight& out) const {
+    const std::size_t size = hierarchy_.Size();
+    const int channels = model_.ChannelSet().Count();
+    out.sides.Assign(size);
+    out.integral.Assign(size);
+    out.moment.Assign(size);
+    const auto holds = [&](std::uint32_t n) { return !links.source[n].empty(); };
+    const auto add = [&](std::uint32_t n, std::vector<double>& visibility) {
+        for (const SourceLink& link : links.source[n]) visibility[link.source] += link.visibility;
+    };
+    const auto leaf = [&](std::uint32_t n, const std::vector<double>& visibility) {
+        const HrcNode& node = hierarchy_[n];
+        for (std::size_t s = 0; s < sources.size(); ++s) {
+            if (visibility[s] <= 0.0) continue;
+            const double cosine = glm::dot(node.normal, sources[s].toward);
+            const int side = cosine > 0.0 ? kUpper : kLower;
+            if (model_.Inner(node.triangle, side)) continue;
+            double* sides = out.sides(n, side);
+            double* integral = out.integral[n];
+            glm::dvec3* moment = out.moment[n];
+            for (int k = 0; k < channels; ++k) {
+                const double normal = sources[s].normalIrradiance[k] * visibility[s];
+                sides[k] += normal * std::abs(cosine);
+                integral[k] += normal;
+                moment[k] += normal * sources[s].toward;
+            }
+        }
+    };
+    const auto top = [&](std::uint32_t t, const std::vector<double>& visibility, Scratch& scratch) {
+        DescendPatches(t, visibility, scratch.levels, 0, holds, add, leaf);
+    };
+    DescendAll(sources.size(), holds, add, top);
+}
+
+// An arrival on a patch, as PushDown hands it down: per channel, W/m² on the upper and
+// the lower side, ∫ L dω, and ∫ L ω dω (three numbers).
+namespace {
+struct Arrival {
+    double* data;
+    int channels;
+    double* Side(int side) const { return data + side * channels; }
+    double* Integral() const { return data + 2 * channels; }
+    double* Moment(int k) const { return data + 3 * channels + 3 * k; }
+    static std::size_t Width(int channels) { return 6 * static_cast<std::size_t>(channels); }
+};
+struct ConstArrival {
+    const double* data;
+    int channels;
+    const double* Side(int side) const { return data + side * channels; }
+    const double* Integral() const { return data + 2 * channels; }
+    glm::dvec3 Moment(int k) const {
+        const double* m = data + 3 * channels + 3 * k;
+        return {m[0], m[1], m[2]};
+    }
+};
+}  // namespace
+
+template <bool kDirections>
+void PushPull::PushDown(const Links& links, const Gathered& gathered, const SourceLight& sources,
+                        LeafLight& leafLight) const {
+    const int bins = model_.BinCount();
+    const int channels = model_.ChannelSet().Count();
+    const DirectionSet& directions = model_.Directions();
+    const auto gathers = [&](std::uint32_t n) {
+        return !model_.Planar(n) && !links.node[n].empty();
+    };
+    const auto holds = [&](std::uint32_t n) { return gathers(n) || exposure_.Exposed(n); };
+    const auto add = [&](std::uint32_t n, std::vector<double>& sum) {
+        if (exposure_.Exposed(n)) {
+            const float* share = exposure_.Share(n);
+            for (int d = 0; d < bins; ++d) {
+                for (int k = 0; k < channels; ++k)
+                    sum[d * channels + k] *= static_cast<double>(share[d]);
+            }
+        }
+        if (!gathers(n)) return;
+        const double* in = gathered.bins[model_.Slot(n)];
+        for (int i = 0; i < bins * channels; ++i) sum[i] += in[i];
+    };
+    const auto patchHolds = [&](std::uint32_t n) { return !links.node[n].empty(); };
+    const auto addGathered = [&](std::uint32_t n, std::vector<double>& value) {
+        const Arrival in{value.data(), channels};
+        const double* upper = gathered.sides(n, kUpper);
+        const double* lower = gathered.sides(n, kLower);
+        for (int k = 0; k < channels; ++k) {
+            in.Side(kUpper)[k] += upper[k];
+            in.Side(kLower)[k] += lower[k];
+            if constexpr (kDirections) {
+                in.Integral()[k] += gathered.integral[n][k];
+                const glm::dvec3& m = gathered.moment[n][k];
+                double* moment = in.Moment(k);
+                moment[0] += m.x, moment[1] += m.y, moment[2] += m.z;
+            }
+        }
+    };
+    const auto leaf = [&](std::uint32_t n, const std::vector<double>& value) {
+        const ConstArrival in{value.data(), channels};
+        for (int side : {kUpper, kLower}) {
+            double* irradiance = leafLight.irradiance(n, side);
+            const double* source = sources.sides(n, side);
+            for (int k = 0; k < channels; ++k) irradiance[k] = in.Side(side)[k] + source[k];
+        }
+        if constexpr (kDirections) {
+            for (int k = 0; k < channels; ++k) {
+                leafLight.integral[n][k] = in.Integral()[k] + sources.integral[n][k];
+                leafLight.moment[n][k] = in.Moment(k) + sources.moment[n][k];
+            }
+        }
+    };
+    const auto top = [&](std::uint32_t t, const std::vector<double>& sum, Scratch& scratch) {
+        // The clusters' light on t's normal, once for the patches t was split into.
+        const HrcNode& node = hierarchy_[t];
+        scratch.top.assign(Arrival::Width(channels), 0.0);
+        const Arrival in{scratch.top.data(), channels};
+        for (int d = 0; d < bins; ++d) {
+            const glm::dvec3& omega = directions.Direction(d);
+            const auto [side, lobe] = model_.BinCosine(node, d);
+            if (model_.Inner(node.triangle, side)) continue;
+            for (int k = 0; k < channels; ++k) {
+                const double normal = sum[d * channels + k];
+                in.Side(side)[k] += normal * lobe;
+                if constexpr (kDirections) {
+                    in.Integral()[k] += normal;
+                    double* moment = in.Moment(k);
+                    const glm::dvec3 part = normal * omega;
+                    moment[0] += part.x, moment[1] += part.y, moment[2] += part.z;
+                }
+            }
+        }
+        // What t, the patches it was split from and the flat clusters above gathered.
+        for (std::uint32_t m = t; m != kNoNode && model_.Planar(m); m = hierarchy_[m].parent)
+            addGathered(m, scratch.top);
+        DescendPatches(t, scratch.top, scratch.levels, 0, patchHolds, addGathered, leaf);
+    };
+    DescendAll(static_cast<std::size_t>(bins) * channels, holds, add, top);
+}
+
+template void PushPull::PushDown<false>(const Links&, const Gathered&, const SourceLight&,
+                                        LeafLight&) const;
+template void PushPull::PushDown<true>(const Links&, const Gathered&, const SourceLight&,
+                                       LeafLight&) const;
+
+}  // namespace leaflux

@@ -1,0 +1,283 @@
+#include "solver/radiosity/refinement.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numeric>
+
+#include "solver/util/check.h"
+
+namespace leaflux {
+
+void Refiner::SplitNode(std::uint32_t n) {
+    const HrcNode& node = hierarchy_[n];
+    if (!node.patch || !node.children.empty()) return;
+    model_.Subdivide(n);
+    field_.Resize(hierarchy_.Size());
+    links_.Resize(hierarchy_.Size());
+    for (std::uint32_t child : hierarchy_[n].children) {
+        field_.radiosity.CopyRow(child, n);
+        field_.emitted[child] = 0.25 * field_.emitted[n];
+    }
+    if (onSplit_) onSplit_(n);
+}
+
+// Refinement is a stack of tasks worked through in chunks: the verdict on each task of
+// a chunk (estimates, form factors, visibility rays) is found in parallel from a
+// hierarchy that does not change meanwhile, then the verdicts are carried out in order
+// — links stored, nodes split and their parts pushed as new tasks. The same tasks give
+// the same links whatever the number of threads.
+void Refiner::Refine(std::vector<Task> stack) {
+    constexpr std::size_t kChunk = 4096;
+    std::vector<Task> chunk;
+    std::vector<Verdict> verdicts;
+    while (!stack.empty()) {
+        const std::size_t take = std::min(kChunk, stack.size());
+        chunk.assign(stack.end() - take, stack.end());
+        stack.resize(stack.size() - take);
+        verdicts.assign(take, Verdict{});
+        tbb::parallel_for(std::size_t{0}, take,
+                          [&](std::size_t i) { verdicts[i] = Judge(chunk[i]); });
+        // Carried out in reverse so that the first task's parts are on top of the stack.
+        for (std::size_t i = take; i-- > 0;) Carry(chunk[i], verdicts[i], stack);
+    }
+}
+
+Refiner::Verdict Refiner::Judge(const Task& task) const {
+    switch (task.kind) {
+        case Task::kSource:
+            return JudgeSource(task.r, task.s);
+        case Task::kPair:
+            return JudgePair(task.r, task.s);
+        case Task::kSplit:
+            return {SplitChoice(task.r, task.s), {}, 0};
+        case Task::kSelf:
+            return {};
+    }
+    return {};
+}
+
+void Refiner::Carry(const Task& task, const Verdict& verdict, std::vector<Task>& stack) {
+    rays_ += verdict.rays;
+    const std::uint32_t r = task.r, s = task.s;
+    if (task.kind == Task::kSelf) {
+        if (hierarchy_[r].patch) return;  // flat: a patch does not see itself
+        const auto& children = hierarchy_[r].children;
+        for (auto i = children.rbegin(); i != children.rend(); ++i) {
+            stack.push_back({Task::kSelf, *i, *i});
+            for (auto j = children.rbegin(); j != children.rend(); ++j) {
+                if (i != j) stack.push_back({Task::kPair, *i, *j});
+            }
+        }
+        return;
+    }
+    switch (verdict.kind) {
+        case Verdict::kNone:
+            return;
+        case Verdict::kLink:
+            if (task.kind == Task::kSource) {
+                links_.source[r].push_back({s, verdict.visibility});
+            } else {
+                links_.node[r].push_back(verdict.link);
+            }
+            return;
+        case Verdict::kSplitReceiver:
+        case Verdict::kSplitSender: {
+            const bool receiver = verdict.kind == Verdict::kSplitReceiver;
+            SplitNode(receiver ? r : s);
+            const auto& children = hierarchy_[receiver ? r : s].children;
+            const Task::Kind kind = task.kind == Task::kSource ? Task::kSource : Task::kPair;
+            for (auto child = children.rbegin(); child != children.rend(); ++child) {
+                stack.push_back({kind, receiver ? *child : r, receiver ? s : *child});
+            }
+            return;
+        }
+    }
+}
+
+Refiner::Verdict Refiner::JudgeSource(std::uint32_t r, std::uint32_t s) const {
+    const DirectionalSource& source = sources_[s];
+    const double power = model_.ChannelSet().Measure(source.normalIrradiance.data());
+    const double unoccluded = power * model_.ProjectedArea(r, source.toward);
+    if (unoccluded <= 0.0) return {};
+    // The spread is least when every ray agrees: beyond ε even then, no ray can save
+    // the link, and none is traced.
+    const double threshold = SourceThreshold(r);
+    if (unoccluded * VisibilitySpread(1.0, visibility_.SourceRays()) > threshold &&
+        model_.CanSplit(r))
+        return {Verdict::kSplitReceiver, {}, 0.0f, 0};
+    Verdict verdict;
+    const double v = visibility_.FromSource(r, s, source.toward, verdict.rays);
+    const double error = unoccluded * VisibilitySpread(v, visibility_.SourceRays());
+    if (error > threshold && model_.CanSplit(r)) {
+        verdict.kind = Verdict::kSplitReceiver;
+    } else if (v > 0.0) {
+        verdict.kind = Verdict::kLink;
+        verdict.visibility = static_cast<float>(v);
+    }
+    return verdict;
+}
+
+double Refiner::SourceThreshold(std::uint32_t r) const {
+    const auto sources = static_cast<double>(std::max<std::size_t>(thresholds_.sourceCount, 1));
+    return model_.Shared(r) ? thresholds_.errorW / std::sqrt(sources) : thresholds_.errorW;
+}
+
+Refiner::Verdict::Kind Refiner::SplitChoice(std::uint32_t r, std::uint32_t s) const {
+    const bool receiverLarger = hierarchy_[r].radius >= hierarchy_[s].radius;
+    const auto larger = receiverLarger ? Verdict::kSplitReceiver : Verdict::kSplitSender;
+    const auto smaller = receiverLarger ? Verdict::kSplitSender : Verdict::kSplitReceiver;
+    if (model_.CanSplit(receiverLarger ? r : s)) return larger;
+    if (model_.CanSplit(receiverLarger ? s : r)) return smaller;
+    return Verdict::kNone;
+}
+
+// Links s → r, or splits the pair when the link would carry more error than ε of the
+// source power: a sender still dark is linked where it stands, and relinked by
+// Rerefine once it has lit up.
+Refiner::Verdict Refiner::JudgePair(std::uint32_t r, std::uint32_t s) const {
+    const bool exact = hierarchy_[r].patch && hierarchy_[s].patch;
+    if (exact && Estimator::InPlane(hierarchy_[r], hierarchy_[s])) return {};
+    Estimate e = exact ? estimator_.Exact(r, s) : estimator_.Pair(r, s);
+    if (exact && !e.near && e.form.upper + e.form.lower <= 0.0) return {};
+    // Geometry and the least spread any rays could show may call for a split: then no
+    // visibility rays are spent on it.
+    const double threshold = Threshold(r);
+    if (e.Error(VisibilitySpread(1.0, visibility_.VisibilityRays())) > threshold) {
+        if (const auto split = SplitChoice(r, s); split != Verdict::kNone)
+            return {split, {}, 0.0f, 0};
+    }
+    // Past that, the form factor at the points that carry light (ReceiverPoints) is what
+    // the rays, the error and the transfer take.
+    if (exact) {
+        e = estimator_.Exact(r, s, Points::kTransfer);
+    } else if (e.sided && hierarchy_[r].patch) {
+        e = estimator_.Pair(r, s, Points::kTransfer);
+    }
+    Verdict verdict;
+    const double unoccluded = exact ? e.form.upper + e.form.lower : 0.0;
+    const Sight sight = visibility_.Between(r, s, RaySet::kJudging, verdict.rays, unoccluded);
+    if (e.Error(sight.spread) > threshold) {
+        if (const auto split = SplitChoice(r, s); split != Verdict::kNone) {
+            verdict.kind = split;
+            return verdict;
+        }
+    }
+    if (exact && unoccluded <= 0.0) return verdict;
+    // A link whose rays are all blocked is kept, carrying nothing: judged again with the
+    // light of the solution (Rerefine), it is split where its sender turns out bright. A
+    // sender lit only by scattered light was dark when first judged; dropped, such links
+    // were never judged again, and a dense 2,000-leaf canopy lost 3.8 % of its NIR at
+    // ε = 1e-5 (1.3 % with them kept, before Value).
+    verdict.kind = Verdict::kLink;
+    NodeLink& link = verdict.link;
+    link.sender = s;
+    link.exact = exact;
+    link.sided = e.sided;
+    link.senderPlane = model_.Planar(s);
+    link.senderSide = static_cast<std::uint8_t>(e.senderSide);
+    link.spread = static_cast<std::uint16_t>(std::lround(sight.spread * NodeLink::kUnit));
+    link.toSender = e.toSender;
+    link.reach = static_cast<float>(e.reach);
+    link.sideReach = static_cast<float>(e.sideReach);
+    link.geometricError = static_cast<float>(e.geometricError);
+    if (!exact) {
+        link.receiverBins = Locate(model_.Directions(), e.toSender);
+        link.senderBins = Locate(model_.Directions(), -e.toSender);
+    }
+    if (e.Error(kWidestSpread) > threshold) {
+        Value(r, link, e, verdict.rays);
+    } else {
+        SetTransfer(link, e, sight.visibility);
+    }
+    return verdict;
+}
+
+void Refiner::SetTransfer(NodeLink& link, const Estimate& e, double v) const {
+    if (link.exact || link.sided) {
+        link.transfer = {static_cast<float>(e.form.upper * v), static_cast<float>(e.form.lower * v),
+                         static_cast<float>(e.form.solidAngleSr * v)};
+    } else {
+        link.transfer[0] = static_cast<float>(v * e.geometric);
+    }
+}
+
+// A link kept only because its rays agreed (all passed, or all were blocked) must not
+// carry the visibility of those rays: links kept where they happened to agree and split
+// where they did not are a biased choice, and the ones that happened to be blocked are
+// kept at zero. The transfer then takes its visibility from a second set of rays, which
+// no verdict reads: the dense canopy's NIR balance went from 1.3 % to 0.3 % at
+// ε = 1e-5, for 1.3 % more rays. `e` is the link's estimate (Estimator::Exact or
+// Estimator::Pair).
+void Refiner::Value(std::uint32_t r, NodeLink& link, const Estimate& e, std::int64_t& rays) const {
+    const double unoccluded = link.exact ? e.form.upper + e.form.lower : 0.0;
+    SetTransfer(link, e,
+                visibility_.Between(r, link.sender, RaySet::kValuing, rays, unoccluded).visibility);
+    link.ownRays = true;
+}
+
+double Refiner::LinkError(const NodeLink& link, double spread) const {
+    const std::uint32_t s = link.sender;
+    double power = field_.emitted[s];
+    if (link.reach >= 0.0f) {
+        const Channels& channels = model_.ChannelSet();
+        thread_local std::vector<double> sent;
+        sent.resize(channels.Count());
+        Sent(link, field_, model_.Slot(s), channels.Count(), sent.data());
+        const double light = channels.Measure(sent.data());
+        power = static_cast<double>(link.reach) * light;
+        if (!link.exact) power = std::min(power, field_.emitted[s]);
+    }
+    const double across =
+        std::abs(model_.SideRadiosity(field_, s, kLower) - model_.SideRadiosity(field_, s, kUpper));
+    return power * (static_cast<double>(link.geometricError) + spread) +
+           static_cast<double>(link.sideReach) * across;
+}
+
+bool Refiner::Rerefine() {
+    const std::size_t count = links_.node.size();
+    // Per receiver, in parallel: the links that fail move to the end of its list; those
+    // kept now only because their rays agreed take rays of their own (Value).
+    std::vector<std::uint32_t> failing(count, 0);
+    std::atomic<std::int64_t> valueRays{0};
+    tbb::parallel_for(std::size_t{0}, count, [&](std::size_t r) {
+        auto& links = links_.node[r];
+        const double threshold = Threshold(static_cast<std::uint32_t>(r));
+        const auto kept = std::stable_partition(
+            links.begin(), links.end(),
+            [&](const NodeLink& link) { return LinkError(link, link.Spread()) <= threshold; });
+        failing[r] = static_cast<std::uint32_t>(links.end() - kept);
+        std::int64_t rays = 0;
+        for (auto link = links.begin(); link != kept; ++link) {
+            if (link->ownRays || LinkError(*link, kWidestSpread) <= threshold) continue;
+            const auto receiver = static_cast<std::uint32_t>(r);
+            Value(receiver, *link,
+                  link->exact ? estimator_.Exact(receiver, link->sender, Points::kTransfer)
+                              : estimator_.Pair(receiver, link->sender, Points::kTransfer),
+                  rays);
+        }
+        valueRays += rays;
+    });
+    rays_ += valueRays;
+    std::vector<Task> stack;
+    for (std::uint32_t r = count; r-- > 0;) {
+        auto& links = links_.node[r];
+        std::vector<NodeLink> unsplittable;  // neither end can be split: the link stays
+        for (std::size_t i = links.size(); i-- > links.size() - failing[r];) {
+            if (SplitChoice(r, links[i].sender) == Verdict::kNone) {
+                unsplittable.push_back(links[i]);
+            } else {
+                stack.push_back({Task::kSplit, r, links[i].sender});
+            }
+        }
+        links.resize(links.size() - failing[r]);
+        links.insert(links.end(), unsplittable.rbegin(), unsplittable.rend());
+    }
+    if (stack.empty()) return false;
+    Refine(std::move(stack));
+    return true;
+}
+
+}  // namespace leaflux

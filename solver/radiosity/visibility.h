@@ -1,0 +1,90 @@
+// The visibility of links and source links: the unoccluded fraction of what a link
+// carries, from deterministic stratified rays through the ray engine, and how far those
+// rays disagreed (the spread refinement weighs). Reads the hierarchy, the node model and
+// the light leaving the nodes (rays from a cluster are weighted by it); owns nothing.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <glm/glm.hpp>
+
+#include "solver/radiosity/light_state.h"
+#include "solver/radiosity/node_model.h"
+#include "solver/raytrace/raytrace.h"
+
+namespace leaflux {
+
+// How uncertain a visibility estimated from n rays is, as 2√(v(1−v)) with v taken by
+// Laplace's rule, (visible + 1) / (n + 2): never zero, since eight rays that all pass do
+// not prove that nothing is in the way. At most 1 (kWidestSpread), for v = ½.
+inline constexpr double kWidestSpread = 1.0;
+inline double VisibilitySpread(double visible, int rays) {
+    const double v = (visible * rays + 1.0) / (rays + 2.0);
+    return 2.0 * std::sqrt(v * (1.0 - v));
+}
+
+// The two sets of visibility rays of a link, as random streams: those that judge it and
+// those that value its transfer where the verdict rested on the first (Refiner::Value).
+enum class RaySet : std::uint64_t { kJudging = 0x5EED, kValuing = 0x5EEE };
+
+// What a link's rays show.
+struct Sight {
+    double visibility = 0.0;
+    // How far the rays disagreed (VisibilitySpread of the fraction that passed): the
+    // weighted visibility can be 0 or 1 while they did not, one near ray outweighing the
+    // rest.
+    double spread = 0.0;
+};
+
+class LinkVisibility {
+  public:
+    LinkVisibility(const NodeModel& model, const Field& field, const RayScene& rays,
+                   int visibilityRays, int sourceRays)
+        : hierarchy_(model.Nodes()),
+          model_(model),
+          field_(field),
+          rays_(rays),
+          visibilityRays_(visibilityRays),
+          sourceRays_(sourceRays) {}
+
+    int VisibilityRays() const { return visibilityRays_; }
+    int SourceRays() const { return sourceRays_; }
+
+    // rays between points x of r and y of s, each weighted by what it carries, the form
+    // factor's kernel |cos θx| |cos θy| / |x − y|² (the receiving cosine as push-down hands
+    // the light to patches). Unweighted, far pairs count as much as near ones and are more
+    // often blocked: the 500-leaf canopy at ρ = τ = 0.45 lost 2.3 % of its NIR that way.
+    // Between two patches, `unoccluded` is the analytic form factor: the rays then estimate
+    // only the part that is blocked, (A_S / π) × the mean of kernel × blocked, taken off the
+    // analytic value. That estimate is unbiased and a link whose rays all pass keeps the
+    // exact form factor; the weighted ratio is biased low with 8 rays, and the stability
+    // suite's dense canopies lost 0.35–0.47 % of their light that way. The estimate is kept
+    // within [−1, 1]: cut at 0 it was biased high where one near blocked ray outweighs the
+    // rest (the stiff canopy of ρ = τ = 0.45 then gained 0.3 % of its light), and down to −1
+    // a link never carries more than the unoccluded form factor, so that the sweeps still
+    // converge. From a cluster, each ray is weighted as well by the radiosity of y's side
+    // facing x, all bands: the link carries the visible share of the light the cluster
+    // sends, not of its area, and the leaves of a crown that a ground patch sees are its
+    // outer, sunlit ones. Weighted by area alone, the 10k tree's links from clusters into
+    // ground patches handed on 0.74 of what rays from their senders landed (the audit of then) and
+    // its NIR balance was 0.83 % off; now 0.80 and 0.38 %. The radiosity is that of when the link
+    // is valued: the direct light's at first, the solution's in the refine–solve passes.
+    // Counts the rays it traces in `rays`.
+    Sight Between(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
+                  double unoccluded = 0.0) const;
+
+    // The lit fraction of node r's area as seen from directional source `source`
+    // (towards `toward`): sample points weighted by |n · ω|, the weight with which push-down
+    // hands the source's light to each patch.
+    double FromSource(std::uint32_t r, std::uint32_t source, const glm::dvec3& toward,
+                      std::int64_t& rays) const;
+
+  private:
+    const Hierarchy& hierarchy_;
+    const NodeModel& model_;
+    const Field& field_;
+    const RayScene& rays_;
+    const int visibilityRays_, sourceRays_;
+};
+
+}  // namespace leaflux
