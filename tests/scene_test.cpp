@@ -59,7 +59,7 @@ std::vector<BadInput> BadInputs() {
          {}},
         {"too many bands",
          [](Scene& s) {
-             for (int i = 0; i < 9; ++i) s.bands.push_back({"b" + std::to_string(i)});
+             for (int i = 0; i < kMaxBands; ++i) s.bands.push_back({"b" + std::to_string(i)});
          },
          ErrorCode::kInvalidArgument,
          "bands",

@@ -25,7 +25,10 @@ constexpr int kUpper = 0, kLower = 1;
 // (the weight is divided by it, so the estimate stays unbiased).
 constexpr double kMaxSurvival = 0.995;
 
-using Spectrum = std::array<double, kMaxBands>;
+// Paths carry their spectrum in fixed-size arrays: a solve takes at most this many bands
+// at once, and a scene of more is solved a group of bands at a time (SolveReference).
+constexpr int kBandGroup = 8;
+using Spectrum = std::array<double, kBandGroup>;
 
 // Everything the paths need to know of the sources, prepared once per solve.
 class Lights {
@@ -199,7 +202,7 @@ double PowerHeuristic(double pdfA, double pdfB) {
 struct SourceLight {
     Spectrum irradiance[2]{};
     Spectrum radianceIntegral{};
-    std::array<glm::dvec3, kMaxBands> radianceMoment{};
+    std::array<glm::dvec3, kBandGroup> radianceMoment{};
 };
 
 // The tallies of one replicate of one receiver, per band, as sample means.
@@ -207,7 +210,7 @@ struct Tally {
     Spectrum irradiance[2]{};
     Spectrum direct[2]{};  // the part that came straight from a source
     Spectrum radianceIntegral{};
-    std::array<glm::dvec3, kMaxBands> radianceMoment{};
+    std::array<glm::dvec3, kBandGroup> radianceMoment{};
     Spectrum escaping{};  // radiosity leaving towards nothing (W/m²), emission aside
 };
 
@@ -469,11 +472,10 @@ Estimate Combine(const std::vector<double>& values) {
     return e;
 }
 
-}  // namespace
-
-Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScene& rays,
-                        const ReferenceOptions& options) {
+Solution SolveGroup(const Scene& scene, const FlatScene& flat, const RayScene& rays,
+                    const ReferenceOptions& options) {
     LEAFLUX_CHECK(options.replicates >= 2);
+    LEAFLUX_CHECK(scene.bands.size() <= static_cast<std::size_t>(kBandGroup));
     const ResourceClock clock;
     const int bands = static_cast<int>(scene.bands.size());
     const auto receivers = static_cast<std::uint32_t>(flat.receivers.size());
@@ -485,7 +487,7 @@ Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScen
     solution.light.assign(receivers, std::vector<BandLight>(bands));
     // Per receiver and band: incident − absorbed − escaped of each replicate, for the
     // standard error of the balance; the sums are made in receiver order afterwards.
-    std::vector<std::array<Estimate, kMaxBands>> incident(receivers), absorbed(receivers),
+    std::vector<std::array<Estimate, kBandGroup>> incident(receivers), absorbed(receivers),
         escaped(receivers), residual(receivers);
     std::atomic<std::int64_t> rayCount{0};
     std::atomic<std::uint32_t> done{0};
@@ -567,6 +569,34 @@ Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScen
     clock.Stamp(solution.stats);
     solution.stats.rays = rayCount;
     solution.stats.threads = threads;
+    return solution;
+}
+
+}  // namespace
+
+// Bands never mix: a scene of more bands than a path carries is solved a group at a time,
+// each group's paths as a scene of those bands alone would take them (the same seed).
+Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScene& rays,
+                        const ReferenceOptions& options) {
+    const int bands = static_cast<int>(scene.bands.size());
+    if (bands <= kBandGroup) return SolveGroup(scene, flat, rays, options);
+    const ResourceClock clock;
+    Solution solution;
+    solution.light.assign(flat.receivers.size(), {});
+    for (int first = 0; first < bands; first += kBandGroup) {
+        std::vector<int> group;
+        for (int b = first; b < std::min(bands, first + kBandGroup); ++b) group.push_back(b);
+        const Solution part = SolveGroup(WithBands(scene, group), flat, rays, options);
+        for (std::size_t r = 0; r < part.light.size(); ++r) {
+            solution.light[r].insert(solution.light[r].end(), part.light[r].begin(),
+                                     part.light[r].end());
+        }
+        solution.balance.insert(solution.balance.end(), part.balance.begin(),
+                                part.balance.end());
+        solution.stats.rays += part.stats.rays;
+        solution.stats.threads = part.stats.threads;
+    }
+    clock.Stamp(solution.stats);
     return solution;
 }
 

@@ -22,8 +22,8 @@ namespace leaflux {
 
 using NodeId = std::uint64_t;
 inline constexpr NodeId kNoParent = 0;
-// Bands carry fixed-size arrays in hot loops; a session declares at most this many.
-inline constexpr int kMaxBands = 8;
+// A session declares at most this many bands: every solve's work and memory grow with them.
+inline constexpr int kMaxBands = 64;
 
 enum class NodeType { kPlant, kAxis, kPhytomer, kLeaf, kInternode, kFruit, kOther };
 const char* NodeTypeName(NodeType type);
