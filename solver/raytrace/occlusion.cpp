@@ -1,0 +1,152 @@
+#include "solver/raytrace/occlusion.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "solver/util/check.h"
+
+namespace leaflux {
+
+// What the boxes' callbacks read and write for one ray: the ray in double precision, the
+// instances to leave out, and the product so far with the instances already in it.
+struct ProxyQuery {
+    RTCIntersectContext context;  // first: Embree hands the callbacks this pointer
+    const Occlusion* occlusion;
+    glm::dvec3 origin, direction;
+    double tFar;
+    std::span<const std::uint32_t> exclude;
+    double transmittance = 1.0;
+    std::vector<std::uint32_t> counted;
+
+    // Multiplies in box `id` once; false when nothing passes any more.
+    bool Cross(std::uint32_t id) {
+        if (std::find(exclude.begin(), exclude.end(), id) != exclude.end()) return true;
+        if (std::find(counted.begin(), counted.end(), id) != counted.end()) return true;
+        const Occlusion::Box& box = occlusion->boxes_[id];
+        const glm::dvec3 o = glm::dvec3(box.instanceFromScene * glm::dvec4(origin, 1.0));
+        const glm::dvec3 d = glm::dmat3(box.instanceFromScene) * direction;
+        double enter = -std::numeric_limits<double>::infinity();
+        double exit = std::numeric_limits<double>::infinity();
+        for (int axis = 0; axis < 3; ++axis) {
+            if (d[axis] == 0.0) {
+                if (o[axis] < box.boxMin[axis] || o[axis] > box.boxMax[axis]) return true;
+                continue;
+            }
+            double t0 = (box.boxMin[axis] - o[axis]) / d[axis];
+            double t1 = (box.boxMax[axis] - o[axis]) / d[axis];
+            if (t0 > t1) std::swap(t0, t1);
+            enter = std::max(enter, t0);
+            exit = std::min(exit, t1);
+        }
+        const double from = std::max(enter, 0.0), to = std::min(exit, tFar);
+        if (!(to > from) || !(exit > enter)) return true;
+        counted.push_back(id);
+        const double tau =
+            std::clamp(occlusion->proxies_[id].transmittance(glm::normalize(d)), 0.0, 1.0);
+        const double fraction = std::min((to - from) / (exit - enter), 1.0);
+        transmittance *= fraction >= 1.0 ? tau : std::pow(tau, fraction);
+        return transmittance > 0.0;
+    }
+};
+
+void Occlusion::Bounds(const RTCBoundsFunctionArguments* args) {
+    const auto* self = static_cast<const Occlusion*>(args->geometryUserPtr);
+    const Box& box = self->boxes_[args->primID];
+    RTCBounds* out = args->bounds_o;
+    // Rounded outwards, so that the float box holds the double one.
+    out->lower_x = std::nextafter(static_cast<float>(box.lower.x), -INFINITY);
+    out->lower_y = std::nextafter(static_cast<float>(box.lower.y), -INFINITY);
+    out->lower_z = std::nextafter(static_cast<float>(box.lower.z), -INFINITY);
+    out->upper_x = std::nextafter(static_cast<float>(box.upper.x), INFINITY);
+    out->upper_y = std::nextafter(static_cast<float>(box.upper.y), INFINITY);
+    out->upper_z = std::nextafter(static_cast<float>(box.upper.z), INFINITY);
+}
+
+void Occlusion::Crossed(const RTCOccludedFunctionNArguments* args) {
+    auto* query = reinterpret_cast<ProxyQuery*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        // Nothing passes: the ray is occluded and traversal may stop.
+        if (!query->Cross(args->primID)) RTCRayN_tfar(args->ray, args->N, i) = -INFINITY;
+    }
+}
+
+void Occlusion::CrossedIntersect(const RTCIntersectFunctionNArguments* args) {
+    // Only occlusion rays are traced through the boxes; an intersect query reports no hit.
+    (void)args;
+}
+
+Occlusion::Occlusion(const RayScene& triangles, std::vector<ClosedProxy> proxies,
+                     RTCBuildQuality quality, std::shared_ptr<RayDevice> device)
+    : triangles_(triangles), proxies_(std::move(proxies)), device_(std::move(device)) {
+    for (const ClosedProxy& proxy : proxies_) {
+        LEAFLUX_CHECK(proxy.transmittance != nullptr);
+        Box box;
+        box.instanceFromScene = glm::inverse(proxy.sceneFromInstance);
+        box.boxMin = proxy.boxMin;
+        box.boxMax = proxy.boxMax;
+        box.lower = glm::dvec3(std::numeric_limits<double>::infinity());
+        box.upper = -box.lower;
+        for (int corner = 0; corner < 8; ++corner) {
+            const glm::dvec3 p(corner & 1 ? proxy.boxMax.x : proxy.boxMin.x,
+                               corner & 2 ? proxy.boxMax.y : proxy.boxMin.y,
+                               corner & 4 ? proxy.boxMax.z : proxy.boxMin.z);
+            const glm::dvec3 q = glm::dvec3(proxy.sceneFromInstance * glm::dvec4(p, 1.0));
+            box.lower = glm::min(box.lower, q);
+            box.upper = glm::max(box.upper, q);
+        }
+        boxes_.push_back(box);
+    }
+    RTCDevice rtc = device_->Get();
+    scene_ = rtcNewScene(rtc);
+    rtcSetSceneBuildQuality(scene_, quality);
+    if (!boxes_.empty()) {
+        RTCGeometry geometry = rtcNewGeometry(rtc, RTC_GEOMETRY_TYPE_USER);
+        rtcSetGeometryBuildQuality(geometry, quality);
+        rtcSetGeometryUserPrimitiveCount(geometry, static_cast<unsigned>(boxes_.size()));
+        rtcSetGeometryUserData(geometry, this);
+        rtcSetGeometryBoundsFunction(geometry, Bounds, this);
+        rtcSetGeometryOccludedFunction(geometry, Crossed);
+        rtcSetGeometryIntersectFunction(geometry, CrossedIntersect);
+        rtcCommitGeometry(geometry);
+        rtcAttachGeometry(scene_, geometry);
+        rtcReleaseGeometry(geometry);
+    }
+    rtcCommitScene(scene_);
+}
+
+Occlusion::~Occlusion() {
+    if (scene_) rtcReleaseScene(scene_);
+}
+
+double Occlusion::Transmittance(const RayStart& start, const glm::dvec3& direction,
+                                double maxDistance, std::span<const std::uint32_t> exclude) const {
+    if (triangles_.Occluded(start, direction, maxDistance)) return 0.0;
+    if (boxes_.empty()) return 1.0;
+    ProxyQuery query;
+    rtcInitIntersectContext(&query.context);
+    query.occlusion = this;
+    query.origin = start.origin;
+    query.direction = direction;
+    query.tFar = maxDistance;
+    query.exclude = exclude;
+    RTCRay ray;
+    ray.org_x = static_cast<float>(start.origin.x);
+    ray.org_y = static_cast<float>(start.origin.y);
+    ray.org_z = static_cast<float>(start.origin.z);
+    ray.dir_x = static_cast<float>(direction.x);
+    ray.dir_y = static_cast<float>(direction.y);
+    ray.dir_z = static_cast<float>(direction.z);
+    ray.tnear = 0.0f;
+    // A little beyond the end in float: the callback clips to the exact segment in double.
+    ray.tfar = std::isinf(maxDistance) ? INFINITY
+                                       : std::nextafter(static_cast<float>(maxDistance), INFINITY);
+    ray.time = 0.0f;
+    ray.mask = 0xFFFFFFFFu;
+    ray.id = 0;
+    ray.flags = 0;
+    rtcOccluded1(scene_, &query.context, &ray);
+    return query.transmittance;
+}
+
+}  // namespace leaflux
