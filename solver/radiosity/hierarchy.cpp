@@ -5,6 +5,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "solver/raytrace/raytrace.h"
 #include "solver/util/check.h"
 
 namespace leaflux {
@@ -19,7 +20,8 @@ void TriangleMoments(HrcNode& node) {
 }
 }  // namespace
 
-Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat) : flat_(flat) {
+Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat, std::span<const ClosedNode> closed)
+    : flat_(flat), closed_(closed.begin(), closed.end()) {
     // A patch per triangle and fewer clusters than patches, before any subdivision.
     nodes_.reserve(2 * flat.triangles.size());
     // Receivers first: one patch per triangle, grouped when an organ has several.
@@ -39,6 +41,10 @@ Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat) : flat_(flat) {
         if (flat.receivers[r].kind == ReceiverKind::kOrgan)
             organOf[flat.receivers[r].node] = receiverNode[r];
     }
+    // Closed instances under the scene node they hang from (or at the top).
+    std::unordered_map<NodeId, std::vector<std::uint32_t>> closedOf;
+    for (std::size_t c = 0; c < closed_.size(); ++c)
+        closedOf[closed_[c].parent].push_back(AddClosed(static_cast<std::uint32_t>(c)));
     std::vector<NodeId> roots;
     for (const Node& node : scene.nodes) {
         (node.parent == kNoParent ? roots : childrenOf[node.parent]).push_back(node.id);
@@ -57,6 +63,8 @@ Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat) : flat_(flat) {
         }
         std::vector<std::uint32_t> parts;
         if (const auto it = organOf.find(id); it != organOf.end()) parts.push_back(it->second);
+        if (const auto it = closedOf.find(id); it != closedOf.end())
+            parts.insert(parts.end(), it->second.begin(), it->second.end());
         for (NodeId child : childrenOf[id]) {
             if (const auto it = built.find(child); it != built.end()) parts.push_back(it->second);
         }
@@ -70,6 +78,11 @@ Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat) : flat_(flat) {
     for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
         if (flat.receivers[r].kind != ReceiverKind::kOrgan) top.push_back(receiverNode[r]);
     }
+    if (const auto it = closedOf.find(kNoParent); it != closedOf.end())
+        top.insert(top.end(), it->second.begin(), it->second.end());
+    for (const ClosedNode& node : closed_) {
+        LEAFLUX_CHECK(node.parent == kNoParent || built.count(node.parent));
+    }
     if (top.empty()) return;
     root_ = top.size() == 1 ? top[0] : Constrain(std::move(top));
     cumulativeArea_.push_back(0.0);
@@ -77,6 +90,10 @@ Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat) : flat_(flat) {
     orderOf_.assign(flat.triangles.size(), 0);
     ordered_.reserve(triangleOrder_.size());
     for (std::size_t i = 0; i < triangleOrder_.size(); ++i) {
+        if (triangleOrder_[i] & kClosedEntry) {
+            ordered_.push_back({});
+            continue;
+        }
         orderOf_[triangleOrder_[i]] = static_cast<std::uint32_t>(i);
         const Triangle& t = flat.triangles[triangleOrder_[i]];
         ordered_.push_back({t.a, t.b, t.c, t.normal});
@@ -107,6 +124,35 @@ std::uint32_t Hierarchy::AddCluster(std::vector<std::uint32_t> children) {
     return index;
 }
 
+std::uint32_t Hierarchy::AddClosed(std::uint32_t index) {
+    const ClosedNode& closed = closed_[index];
+    HrcNode node;
+    node.closed = static_cast<std::int32_t>(index);
+    node.areaM2 = closed.areaM2;
+    const glm::dvec3 middle = 0.5 * (closed.boxMin + closed.boxMax);
+    node.centre = glm::dvec3(closed.sceneFromInstance * glm::dvec4(middle, 1.0));
+    node.centroid = node.centre;
+    // The box's bounding sphere, and the RMS distance of a uniform point in it from its
+    // centre: √(Σ |edge|² / 12).
+    const glm::dmat3 linear(closed.sceneFromInstance);
+    const glm::dvec3 size = closed.boxMax - closed.boxMin;
+    double second = 0.0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const double edge = glm::length(linear[axis] * size[axis]);
+        second += edge * edge / 12.0;
+    }
+    node.spread = std::sqrt(second);
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec3 p(corner & 1 ? closed.boxMax.x : closed.boxMin.x,
+                           corner & 2 ? closed.boxMax.y : closed.boxMin.y,
+                           corner & 4 ? closed.boxMax.z : closed.boxMin.z);
+        node.radius = std::max(node.radius, glm::length(linear * (p - middle)));
+    }
+    nodes_.push_back(node);
+    closedNode_.push_back(static_cast<std::uint32_t>(nodes_.size() - 1));
+    return closedNode_.back();
+}
+
 std::uint32_t Hierarchy::Constrain(std::vector<std::uint32_t> children) {
     if (children.size() <= static_cast<std::size_t>(kMaxChildren))
         return AddCluster(std::move(children));
@@ -114,6 +160,7 @@ std::uint32_t Hierarchy::Constrain(std::vector<std::uint32_t> children) {
     auto centreOf = [&](std::uint32_t n) {
         const HrcNode& node = nodes_[n];
         if (node.patch) return (node.a + node.b + node.c) / 3.0;
+        if (node.closed >= 0) return node.centre;
         glm::dvec3 sum(0.0);
         std::vector<std::uint32_t> stack = {n};
         int count = 0;
@@ -178,6 +225,13 @@ void Hierarchy::Finish(std::uint32_t index) {
             node.centre = 0.5 * (lo + hi);
             node.radius = 0.5 * glm::length(hi - lo);
             TriangleMoments(node);
+            continue;
+        }
+        if (node.closed >= 0) {  // its geometry is its box's (AddClosed)
+            node.first = static_cast<std::uint32_t>(triangleOrder_.size());
+            node.count = 1;
+            triangleOrder_.push_back(kClosedEntry | static_cast<std::uint32_t>(node.closed));
+            cumulativeArea_.push_back(cumulativeArea_.back() + node.areaM2);
             continue;
         }
         if (!expanded) {
@@ -265,8 +319,19 @@ bool Hierarchy::Subdivide(std::uint32_t index, double minAreaM2) {
     return true;
 }
 
+Hierarchy::Point Hierarchy::SampleClosed(std::int32_t closed, double u, double v) const {
+    // A point of the box from two numbers: the third coordinate from the digits of the first
+    // two that their own coordinates do not resolve.
+    const ClosedNode& node = closed_[closed];
+    const double w = std::fmod(4096.0 * u + 64.0 * v, 1.0);
+    const glm::dvec3 local = node.boxMin + glm::dvec3(u, v, w) * (node.boxMax - node.boxMin);
+    return {glm::dvec3(node.sceneFromInstance * glm::dvec4(local, 1.0)), glm::dvec3(0.0),
+            kNoTriangle, closed};
+}
+
 Hierarchy::Point Hierarchy::Sample(std::uint32_t index, double u, double v) const {
     const HrcNode& node = nodes_[index];
+    if (node.closed >= 0) return SampleClosed(node.closed, u, v);
     if (node.patch) {
         const glm::dvec3 w = UniformTriangle(u, v);
         return {w.x * node.a + w.y * node.b + w.z * node.c, node.normal, node.triangle};
@@ -280,6 +345,8 @@ Hierarchy::Point Hierarchy::Sample(std::uint32_t index, double u, double v) cons
     const std::size_t k = static_cast<std::size_t>(it - cumulativeArea_.begin()) - 1;
     u = std::clamp((target - cumulativeArea_[k]) / (cumulativeArea_[k + 1] - cumulativeArea_[k]),
                    0.0, 1.0);
+    if (triangleOrder_[k] & kClosedEntry)
+        return SampleClosed(static_cast<std::int32_t>(triangleOrder_[k] & ~kClosedEntry), u, v);
     const Corners& t = ordered_[k];
     const glm::dvec3 w = UniformTriangle(u, v);
     return {w.x * t.a + w.y * t.b + w.z * t.c, t.normal, triangleOrder_[k]};

@@ -5,14 +5,18 @@
 // on demand. Clusters follow the botanical topology (plant → axis → … → organ), with
 // extra spatial levels inserted wherever a cluster would have more than kMaxChildren
 // children (a constrained clusterer, §4.1 last paragraph); environment surfaces and lamps
-// are grouped spatially. Invariant: a node's children partition its patches; `first` and
-// `count` index the node's original triangles in `triangleOrder`, contiguous.
+// are grouped spatially. Closed instances (closed_node.h) are nodes without children or
+// triangles, under the scene node they hang from. Invariant: a node's children partition its
+// patches and closed instances; `first` and `count` index the node's original triangles and
+// closed instances in `triangleOrder`, contiguous.
 #pragma once
 
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <span>
 #include <vector>
 
+#include "solver/radiosity/closed_node.h"
 #include "solver/scene/geometry.h"
 #include "solver/util/sampling.h"
 
@@ -32,7 +36,8 @@ struct HrcNode {
     glm::dvec3 a{0.0}, b{0.0}, c{0.0}, normal{0.0};
     std::uint32_t triangle = 0;
     std::uint32_t receiver = 0;
-    int depth = 0;  // subdivision depth of a patch (0: a flat triangle)
+    int depth = 0;             // subdivision depth of a patch (0: a flat triangle)
+    std::int32_t closed = -1;  // a closed instance: its index among Hierarchy::Closed()
     // Every node: area (m²), bounding sphere, area centroid and the RMS distance of its
     // area from that centroid (m), and its original triangles.
     double areaM2 = 0.0;
@@ -45,7 +50,7 @@ struct HrcNode {
 
 class Hierarchy {
   public:
-    explicit Hierarchy(const Scene& scene, const FlatScene& flat);
+    Hierarchy(const Scene& scene, const FlatScene& flat, std::span<const ClosedNode> closed = {});
 
     std::uint32_t Root() const { return root_; }
     HrcNode& operator[](std::uint32_t i) { return nodes_[i]; }
@@ -57,13 +62,19 @@ class Hierarchy {
     // split or its children would be smaller than minAreaM2.
     bool Subdivide(std::uint32_t patch, double minAreaM2);
 
+    const std::vector<ClosedNode>& Closed() const { return closed_; }
+    std::uint32_t NodeOfClosed(std::int32_t closed) const { return closedNode_[closed]; }
+
     // A point on the node's surfaces, area-weighted, from two uniform numbers; with the
-    // flat triangle it lies on (for rays to leave it).
+    // flat triangle it lies on (for rays to leave it). A point of a closed instance lies in
+    // its box, of no triangle and no normal (it takes and sends light in every direction).
     struct Point {
         glm::dvec3 position, normal;
         std::uint32_t triangle;
+        std::int32_t closed = -1;
     };
     Point Sample(std::uint32_t node, double u, double v) const;
+    Point SampleClosed(std::int32_t closed, double u, double v) const;
 
     // The patch a flat triangle was made (before any subdivision), or kNoNode: its radiosity
     // is the mean of its parts'.
@@ -79,6 +90,7 @@ class Hierarchy {
   private:
     std::uint32_t AddPatch(std::uint32_t triangle);
     std::uint32_t AddCluster(std::vector<std::uint32_t> children);
+    std::uint32_t AddClosed(std::uint32_t index);
     // Groups children into at most kMaxChildren subtrees by median splits in space.
     std::uint32_t Constrain(std::vector<std::uint32_t> children);
     void Finish(std::uint32_t node);
@@ -87,8 +99,12 @@ class Hierarchy {
 
     const FlatScene& flat_;
     std::vector<HrcNode> nodes_;
-    std::vector<std::uint32_t> triangleOrder_;  // flat triangles in hierarchy order
-    std::vector<double> cumulativeArea_;        // over triangleOrder_, starting at 0
+    std::vector<ClosedNode> closed_;
+    std::vector<std::uint32_t> closedNode_;  // by closed instance: its node
+    // Flat triangles in hierarchy order, and closed instances as kClosedEntry | index.
+    static constexpr std::uint32_t kClosedEntry = 0x80000000u;
+    std::vector<std::uint32_t> triangleOrder_;
+    std::vector<double> cumulativeArea_;  // over triangleOrder_, starting at 0
     // Their corners and normals in that order, so that sampling a cluster reads contiguous
     // memory rather than the flat scene's triangles scattered.
     struct Corners {

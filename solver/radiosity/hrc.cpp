@@ -11,6 +11,7 @@
 #include <chrono>
 #include <optional>
 
+#include "solver/radiosity/closed_scattering.h"
 #include "solver/radiosity/estimate.h"
 #include "solver/radiosity/exposure.h"
 #include "solver/radiosity/gathering.h"
@@ -74,13 +75,13 @@ std::vector<DirectionalSource> BeamsOf(const Scene& scene, SkyDiscretization sky
 class SceneSolve {
   public:
     SceneSolve(const Scene& scene, const FlatScene& flat, const RayScene& rays,
-               const HrcOptions& options)
+               const HrcOptions& options, std::span<const ClosedNode> closed)
         : scene_(scene),
           flat_(flat),
           rays_(rays),
           options_(options),
           channels_{static_cast<int>(scene.bands.size()), 1, ChannelMeasure::kSum},
-          hierarchy_(scene, flat),
+          hierarchy_(scene, flat, closed),
           model_(hierarchy_, scene, rays, DirectionSet::OfLevel(options.directionLevel), channels_,
                  options.maxSubdivision),
           field_(channels_, model_.BinCount()),
@@ -89,8 +90,10 @@ class SceneSolve {
           leafLight_(channels_),
           optics_(scene, flat, channels_),
           sources_(BeamsOf(scene, options.skyCones)),
+          closedLight_(channels_, model_.BinCount(), closed.size(), sources_.size()),
+          occlusion_(rays, ProxiesOf(closed)),
           estimator_(model_, field_),
-          visibility_(model_, field_, rays, options.visibilityRays, options.sourceRays),
+          visibility_(model_, field_, occlusion_, options.visibilityRays, options.sourceRays),
           pushPull_(model_, traversal_, exposure_) {
         field_.Resize(hierarchy_.Size());
         field_.intensity.Assign(model_.SlotCount());
@@ -125,7 +128,22 @@ class SceneSolve {
     template <bool kDirections>
     void Collect() {
         Gather<kDirections>(model_, field_, links_, traversal_.Receivers(), gathered_);
-        pushPull_.PushDown<kDirections>(links_, gathered_, sourceLight_, leafLight_);
+        pushPull_.PushDown<kDirections>(links_, gathered_, sourceLight_, leafLight_, Closed());
+    }
+    ClosedLight* Closed() { return hierarchy_.Closed().empty() ? nullptr : &closedLight_; }
+    // The radiosity of the leaf patches and the light the closed instances send, from what
+    // arrived: the largest change over the largest value.
+    double Update() {
+        double residual =
+            UpdateRadiosity(hierarchy_, traversal_.Leaves(), optics_, leafLight_, field_);
+        if (Closed())
+            residual = std::max(residual, ScatterClosed(model_, sources_, closedLight_, field_));
+        return residual;
+    }
+    static std::vector<ClosedProxy> ProxiesOf(std::span<const ClosedNode> closed) {
+        std::vector<ClosedProxy> proxies;
+        for (const ClosedNode& node : closed) proxies.push_back(node.Proxy());
+        return proxies;
     }
     void Outputs(Solution& solution);
     std::int64_t rays() const {
@@ -145,6 +163,8 @@ class SceneSolve {
     LeafLight leafLight_;
     const ReceiverOptics optics_;
     const std::vector<DirectionalSource> sources_;
+    ClosedLight closedLight_;
+    const Occlusion occlusion_;
     Links links_;
     Traversal traversal_;
     Exposure exposure_;
@@ -232,10 +252,10 @@ void SceneSolve::Solve(Solution& solution) {
     // Direct light first, so that links are refined on what senders will send; with
     // direct light only, lamps are the only senders and their links the only ones needed.
     Index();
-    pushPull_.PushSources(links_, sources_, sourceLight_);
+    pushPull_.PushSources(links_, sources_, sourceLight_, Closed());
     if (!options_.directOnly) {
-        pushPull_.PushDown<false>(links_, gathered_, sourceLight_, leafLight_);
-        UpdateRadiosity(hierarchy_, traversal_.Leaves(), optics_, leafLight_, field_);
+        pushPull_.PushDown<false>(links_, gathered_, sourceLight_, leafLight_, Closed());
+        Update();
     }
     pushPull_.PullUp(field_);
     const double sourceSeconds = clock.Lap();
@@ -274,8 +294,9 @@ void SceneSolve::Solve(Solution& solution) {
                 Collect<false>();
             }
             if (iteration == 0) leafLight_.direct = leafLight_.irradiance;
-            residual =
-                UpdateRadiosity(hierarchy_, traversal_.Leaves(), optics_, leafLight_, field_);
+            residual = options_.directOnly ? UpdateRadiosity(hierarchy_, traversal_.Leaves(),
+                                                             optics_, leafLight_, field_)
+                                           : Update();
             if (const double factor = convergence.Step(residual); factor > 0.0) {
                 Extrapolate(traversal_.Leaves(), leafLight_, factor, field_);
                 ++solution.stats.extrapolations;
@@ -329,12 +350,12 @@ void SceneSolve::Outputs(Solution& solution) {
 }  // namespace
 
 Solution SolveHrc(const Scene& scene, const FlatScene& flat, const RayScene& rays,
-                  const HrcOptions& options) {
+                  const HrcOptions& options, std::span<const ClosedNode> closed) {
     LEAFLUX_CHECK(options.directionLevel >= 0 && options.directionLevel <= 4);
     LEAFLUX_CHECK(!scene.bands.empty());
     const ResourceClock clock;
     Stopwatch watch;
-    SceneSolve solver(scene, flat, rays, options);
+    SceneSolve solver(scene, flat, rays, options, closed);
     spdlog::debug("hrc: hierarchy built in {:.3f} s", watch.Lap());
     return solver.Run(clock);
 }

@@ -38,7 +38,9 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 
+#include "solver/radiosity/closed_node.h"
 #include "solver/raytrace/raytrace.h"
 #include "solver/results/light.h"
 
@@ -87,7 +89,10 @@ struct HrcOptions {
     SkyDiscretization skyCones = SkyDiscretization::kTurtle46;
 };
 
+// `closed`: closed instances beside the scene's geometry (closed_node.h), each under the
+// scene node it names, in the flat scene's frame; they are not receivers and get no output.
+// Their own absorption is outside the energy balance.
 Solution SolveHrc(const Scene& scene, const FlatScene& flat, const RayScene& rays,
-                  const HrcOptions& options);
+                  const HrcOptions& options, std::span<const ClosedNode> closed = {});
 
 }  // namespace leaflux

@@ -4,7 +4,8 @@
 //               clusters): read by links, written by pull-up and the radiosity update;
 //   Gathered    what links bring to their receivers (Gather);
 //   SourceLight what the directional sources bring to each leaf patch (PushSources);
-//   LeafLight   what arrives on each leaf patch, all of it (PushDown), and what it emits.
+//   LeafLight   what arrives on each leaf patch, all of it (PushDown), and what it emits;
+//   ClosedLight what arrives on each closed instance, from the nodes and from the sources.
 // Each is plain data: the units that fill it say how.
 #pragma once
 
@@ -77,6 +78,15 @@ struct LeafLight {
         integral.Resize(nodes);
         moment.Resize(nodes);
     }
+};
+
+struct ClosedLight {
+    ClosedLight(const Channels& channels, int binCount, std::size_t closed, std::size_t sourceCount)
+        : bins(static_cast<std::size_t>(binCount) * channels.Count(), closed),
+          sources(sourceCount, closed) {}
+
+    Table<double> bins;     // per closed instance: [bin][channel], W/m² normal to the bin
+    Table<double> sources;  // per closed instance: the visibility of each directional source
 };
 
 }  // namespace leaflux

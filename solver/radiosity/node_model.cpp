@@ -36,6 +36,8 @@ void NodeModel::FindOrgans() {
         const HrcNode& node = hierarchy_[n];
         if (node.patch) {
             organs_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kOrgan;
+        } else if (node.closed >= 0) {
+            organs_[n] = 1;
         } else {
             for (std::uint32_t child : node.children) organs_[n] |= organs_[child];
         }
@@ -130,6 +132,17 @@ void NodeModel::AssignSlots() {
     for (auto it = preOrder.rbegin(); it != preOrder.rend(); ++it) {
         const HrcNode& node = hierarchy_[*it];
         if (node.patch) continue;
+        if (const ClosedNode* closed = Closed(*it)) {
+            // The area that intercepts light along ω: the box's, less what passes through.
+            for (int d = 0; d < bins_; ++d) {
+                const glm::dvec3& omega = directions_.Direction(d);
+                projected_[slot_[*it] * bins_ + d] =
+                    closed->BoxProjectedArea(omega) *
+                    (1.0 - std::clamp(closed->contents->Transmittance(closed->ToInstance(omega)),
+                                      0.0, 1.0));
+            }
+            continue;
+        }
         for (std::uint32_t child : node.children) {
             const HrcNode& c = hierarchy_[child];
             for (int d = 0; d < bins_; ++d) {

@@ -42,17 +42,26 @@ class NodeModel {
     }
     // Whether side `side` of a triangle faces the inside of its own solid (an internode,
     // a fruit): it then gets no light.
-    bool Inner(std::uint32_t triangle, int side) const { return inner_[triangle] >> side & 1; }
+    bool Inner(std::uint32_t triangle, int side) const {
+        return triangle != kNoTriangle && inner_[triangle] >> side & 1;
+    }
     bool AnyInner(std::uint32_t triangle) const { return inner_[triangle] != 0; }
     // How much a receiving point of normal n on a triangle takes of light from ω: |n · ω|,
     // but nothing on the inner side of a solid.
+    // A point in a closed instance's box takes light from every direction alike: 1.
     double ReceivingWeight(std::uint32_t triangle, const glm::dvec3& n,
                            const glm::dvec3& omega) const {
+        if (triangle == kNoTriangle) return 1.0;
         const double cosine = glm::dot(n, omega);
         return Inner(triangle, cosine > 0.0 ? kUpper : kLower) ? 0.0 : std::abs(cosine);
     }
+    // The closed instance node n is, or null.
+    const ClosedNode* Closed(std::uint32_t n) const {
+        const std::int32_t c = hierarchy_[n].closed;
+        return c >= 0 ? &hierarchy_.Closed()[c] : nullptr;
+    }
     // Whether a link into node r hands the same light to organs that may see it unevenly:
-    // r is a cluster with organs under it.
+    // r is a cluster with organs under it (a closed instance is one).
     bool Shared(std::uint32_t r) const { return !hierarchy_[r].patch && organs_[r]; }
 
     // The side of patch p facing direction d of the set and p's lobe |n · ω| there, scaled

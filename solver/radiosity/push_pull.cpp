@@ -27,6 +27,7 @@ void PushPull::PullNode(Field& field, std::uint32_t n) const {
     const HrcNode& node = hierarchy_[n];
     const Channels& set = model_.ChannelSet();
     const int channels = set.Count();
+    if (node.closed >= 0) return;  // its light is its phase function's (closed_scattering.h)
     double& emitted = field.emitted[n];
     emitted = 0.0;
     if (node.patch && node.children.empty()) {
@@ -116,7 +117,7 @@ void PushPull::Descend(std::uint32_t start, const std::vector<double>& above, Ho
             sum = entry.depth;
         }
         const HrcNode& node = hierarchy_[entry.node];
-        if (node.patch) {
+        if (node.patch || node.closed >= 0) {
             top(entry.node, sums[sum], scratch);
             continue;
         }
@@ -144,7 +145,7 @@ void PushPull::DescendPatches(std::uint32_t t, const std::vector<double>& value,
 }
 
 void PushPull::PushSources(const Links& links, const std::vector<DirectionalSource>& sources,
-                           SourceLight& out) const {
+                           SourceLight& out, ClosedLight* closed) const {
     const std::size_t size = hierarchy_.Size();
     const int channels = model_.ChannelSet().Count();
     out.sides.Assign(size);
@@ -173,6 +174,10 @@ void PushPull::PushSources(const Links& links, const std::vector<DirectionalSour
         }
     };
     const auto top = [&](std::uint32_t t, const std::vector<double>& visibility, Scratch& scratch) {
+        if (const std::int32_t c = hierarchy_[t].closed; c >= 0) {
+            std::copy(visibility.begin(), visibility.end(), closed->sources[c]);
+            return;
+        }
         DescendPatches(t, visibility, scratch.levels, 0, holds, add, leaf);
     };
     DescendAll(sources.size(), holds, add, top);
@@ -203,7 +208,7 @@ struct ConstArrival {
 
 template <bool kDirections>
 void PushPull::PushDown(const Links& links, const Gathered& gathered, const SourceLight& sources,
-                        LeafLight& leafLight) const {
+                        LeafLight& leafLight, ClosedLight* closed) const {
     const int bins = model_.BinCount();
     const int channels = model_.ChannelSet().Count();
     const DirectionSet& directions = model_.Directions();
@@ -254,8 +259,12 @@ void PushPull::PushDown(const Links& links, const Gathered& gathered, const Sour
         }
     };
     const auto top = [&](std::uint32_t t, const std::vector<double>& sum, Scratch& scratch) {
-        // The clusters' light on t's normal, once for the patches t was split into.
         const HrcNode& node = hierarchy_[t];
+        if (node.closed >= 0) {
+            std::copy(sum.begin(), sum.end(), closed->bins[node.closed]);
+            return;
+        }
+        // The clusters' light on t's normal, once for the patches t was split into.
         scratch.top.assign(Arrival::Width(channels), 0.0);
         const Arrival in{scratch.top.data(), channels};
         for (int d = 0; d < bins; ++d) {
@@ -282,8 +291,8 @@ void PushPull::PushDown(const Links& links, const Gathered& gathered, const Sour
 }
 
 template void PushPull::PushDown<false>(const Links&, const Gathered&, const SourceLight&,
-                                        LeafLight&) const;
+                                        LeafLight&, ClosedLight*) const;
 template void PushPull::PushDown<true>(const Links&, const Gathered&, const SourceLight&,
-                                       LeafLight&) const;
+                                       LeafLight&, ClosedLight*) const;
 
 }  // namespace leaflux

@@ -27,13 +27,16 @@ class PushPull {
     void PullUp(Field& field) const;
     // Per leaf patch, the light of the directional sources through their links; patches
     // split later take their parent's (the driver's split hook).
+    // A closed instance takes the visibility of each source (`closed`, when the hierarchy
+    // has closed instances).
     void PushSources(const Links& links, const std::vector<DirectionalSource>& sources,
-                     SourceLight& out) const;
+                     SourceLight& out, ClosedLight* closed = nullptr) const;
     // Per leaf patch, the source light plus what the clusters and patches above gathered;
     // the radiance integral and moment (the light vector) only with kDirections.
+    // A closed instance takes the light per bin that arrived on it and above it.
     template <bool kDirections>
     void PushDown(const Links& links, const Gathered& gathered, const SourceLight& sources,
-                  LeafLight& leaf) const;
+                  LeafLight& leaf, ClosedLight* closed = nullptr) const;
 
   private:
     // Per task: buffers reused from patch to patch, so that handing light down allocates
@@ -44,7 +47,8 @@ class PushPull {
     };
     void PullNode(Field& field, std::uint32_t n) const;
     // Handing light down to the leaf patches. Descend visits the top patches under `start`
-    // (the first patch on each way down, or `start` itself) with the sum of what their
+    // (the first patch on each way down, or `start` itself) and the closed instances with
+    // the sum of what their
     // ancestors hold: `above` plus, for every node n on the way with holds(n) (the top
     // patch included), what add(n, sum) adds; sums are copied only at such nodes.
     // top(t, sum, scratch) then hands the sum down t's own quadtree, whose patches share a

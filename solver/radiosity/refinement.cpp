@@ -63,7 +63,9 @@ void Refiner::Carry(const Task& task, const Verdict& verdict, std::vector<Task>&
     rays_ += verdict.rays;
     const std::uint32_t r = task.r, s = task.s;
     if (task.kind == Task::kSelf) {
-        if (hierarchy_[r].patch) return;  // flat: a patch does not see itself
+        // A patch does not see itself; a closed instance's phase function holds its own
+        // exchanges.
+        if (hierarchy_[r].patch || hierarchy_[r].closed >= 0) return;
         const auto& children = hierarchy_[r].children;
         for (auto i = children.rbegin(); i != children.rend(); ++i) {
             stack.push_back({Task::kSelf, *i, *i});

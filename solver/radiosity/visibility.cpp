@@ -8,7 +8,30 @@
 namespace leaflux {
 namespace {
 constexpr double kPi = glm::pi<double>();
+
+// The closed instances a ray leaves out: those of its two ends (−1: none).
+struct Exclusion {
+    std::uint32_t ids[2];
+    std::size_t count = 0;
+    explicit Exclusion(const std::int32_t (&ends)[2]) {
+        for (std::int32_t end : ends) {
+            if (end >= 0) ids[count++] = static_cast<std::uint32_t>(end);
+        }
+    }
+    operator std::span<const std::uint32_t>() const { return {ids, count}; }
+};
 }  // namespace
+
+double LinkVisibility::Brightness(const Hierarchy::Point& q, const glm::dvec3& towardQ) const {
+    if (q.closed >= 0) {
+        // A closed instance's radiance towards the ray: its intensity over its area seen.
+        const std::uint32_t n = hierarchy_.NodeOfClosed(q.closed);
+        const double area = model_.ProjectedArea(n, -towardQ);
+        return area > 0.0 ? model_.Power(field_, n, -towardQ) / area : 0.0;
+    }
+    return model_.SideRadiosity(field_, hierarchy_.PatchOf(q.triangle),
+                                glm::dot(q.normal, towardQ) < 0.0 ? kUpper : kLower);
+}
 
 Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
                               double unoccluded) const {
@@ -16,7 +39,8 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std:
     const int count = visibilityRays_;
     const bool fromCluster = !hierarchy_[s].patch;
     double visible = 0.0, total = 0.0, visibleLight = 0.0, totalLight = 0.0;
-    int traced = 0, passed = 0;
+    int traced = 0;
+    double passed = 0.0;
     for (int i = 0; i < count; ++i) {
         const Hierarchy::Point p =
             hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
@@ -24,26 +48,24 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std:
         const glm::dvec3 d = q.position - p.position;
         const double distance = glm::length(d);
         if (distance <= 0.0) continue;
-        const double weight = model_.ReceivingWeight(p.triangle, p.normal, d / distance) *
-                              std::abs(glm::dot(q.normal, d)) / (distance * distance * distance);
+        // |cos θy| d: a point of a closed instance sends alike in every direction.
+        const double sending = q.closed >= 0 ? distance : std::abs(glm::dot(q.normal, d));
+        const double weight = model_.ReceivingWeight(p.triangle, p.normal, d / distance) * sending /
+                              (distance * distance * distance);
         if (weight <= 0.0) continue;
-        const double light =
-            fromCluster
-                ? weight * model_.SideRadiosity(field_, hierarchy_.PatchOf(q.triangle),
-                                                glm::dot(q.normal, d) < 0.0 ? kUpper : kLower)
-                : 0.0;
+        const double light = fromCluster ? weight * Brightness(q, d) : 0.0;
         ++rays, ++traced;
         total += weight;
         totalLight += light;
-        if (!rays_.Occluded({p.position, p.triangle}, d / distance, distance * (1.0 - 1e-4))) {
-            visible += weight;
-            visibleLight += light;
-            ++passed;
-        }
+        const std::int32_t ends[2] = {p.closed, q.closed};
+        const double through = occlusion_.Transmittance({p.position, p.triangle}, d / distance,
+                                                        distance * (1.0 - 1e-4), Exclusion(ends));
+        visible += weight * through;
+        visibleLight += light * through;
+        passed += through;
     }
     Sight sight;
-    sight.spread =
-        VisibilitySpread(traced > 0 ? static_cast<double>(passed) / traced : 1.0, visibilityRays_);
+    sight.spread = VisibilitySpread(traced > 0 ? passed / traced : 1.0, visibilityRays_);
     if (unoccluded > 0.0) {
         const double blocked = hierarchy_[s].areaM2 / kPi * (total - visible) / count;
         sight.visibility = std::clamp(1.0 - blocked / unoccluded, -1.0, 1.0);
@@ -62,7 +84,8 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source, const g
     thread_local std::vector<RayStart> starts;
     thread_local std::vector<double> weights;
     thread_local std::vector<std::uint8_t> occluded;
-    starts.clear(), weights.clear();
+    thread_local std::vector<std::int32_t> closed;
+    starts.clear(), weights.clear(), closed.clear();
     for (int i = 0; i < count; ++i) {
         const Hierarchy::Point p =
             hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
@@ -70,13 +93,23 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source, const g
         if (weight <= 0.0) continue;
         starts.push_back({p.position, p.triangle});
         weights.push_back(weight);
+        closed.push_back(p.closed);
     }
     rays += static_cast<std::int64_t>(starts.size());
-    rays_.Occluded(starts, toward, occluded);
     double visible = 0.0, total = 0.0;
+    if (occlusion_.ProxyCount() == 0) {  // triangles alone, traced together
+        occlusion_.Triangles().Occluded(starts, toward, occluded);
+        for (std::size_t i = 0; i < starts.size(); ++i) {
+            total += weights[i];
+            if (!occluded[i]) visible += weights[i];
+        }
+        return total > 0.0 ? visible / total : 0.0;
+    }
     for (std::size_t i = 0; i < starts.size(); ++i) {
+        const std::int32_t ends[2] = {closed[i], -1};
         total += weights[i];
-        if (!occluded[i]) visible += weights[i];
+        visible +=
+            weights[i] * occlusion_.Transmittance(starts[i], toward, INFINITY, Exclusion(ends));
     }
     return total > 0.0 ? visible / total : 0.0;
 }

@@ -1,6 +1,8 @@
 // The visibility of links and source links: the unoccluded fraction of what a link
-// carries, from deterministic stratified rays through the ray engine, and how far those
-// rays disagreed (the spread refinement weighs). Reads the hierarchy, the node model and
+// carries, from deterministic stratified rays through the ray engine (Occlusion: triangles
+// block, closed instances pass their τ), and how far those rays disagreed (the spread
+// refinement weighs). A ray from or to a point of a closed instance leaves that instance
+// out. Reads the hierarchy, the node model and
 // the light leaving the nodes (rays from a cluster are weighted by it); owns nothing.
 #pragma once
 
@@ -10,7 +12,7 @@
 
 #include "solver/radiosity/light_state.h"
 #include "solver/radiosity/node_model.h"
-#include "solver/raytrace/raytrace.h"
+#include "solver/raytrace/occlusion.h"
 
 namespace leaflux {
 
@@ -38,12 +40,12 @@ struct Sight {
 
 class LinkVisibility {
   public:
-    LinkVisibility(const NodeModel& model, const Field& field, const RayScene& rays,
+    LinkVisibility(const NodeModel& model, const Field& field, const Occlusion& occlusion,
                    int visibilityRays, int sourceRays)
         : hierarchy_(model.Nodes()),
           model_(model),
           field_(field),
-          rays_(rays),
+          occlusion_(occlusion),
           visibilityRays_(visibilityRays),
           sourceRays_(sourceRays) {}
 
@@ -80,10 +82,14 @@ class LinkVisibility {
                       std::int64_t& rays) const;
 
   private:
+    // What a sender's point q sends towards the ray (from the receiver, towardQ), all
+    // channels: the radiosity of a patch's side facing it, a closed instance's radiance.
+    double Brightness(const Hierarchy::Point& q, const glm::dvec3& towardQ) const;
+
     const Hierarchy& hierarchy_;
     const NodeModel& model_;
     const Field& field_;
-    const RayScene& rays_;
+    const Occlusion& occlusion_;
     const int visibilityRays_, sourceRays_;
 };
 

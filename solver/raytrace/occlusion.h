@@ -58,6 +58,7 @@ class Occlusion {
                          std::span<const std::uint32_t> exclude = {}) const;
 
     std::size_t ProxyCount() const { return proxies_.size(); }
+    const RayScene& Triangles() const { return triangles_; }
 
   private:
     struct Box {

@@ -1,0 +1,64 @@
+// A closed instance (Soler 2003 §3.2, §4): a structure whose geometry is not loaded, known
+// by what it does to light — its directional transmittance τ(ω) and its phase function
+// f(ωi, ωo) — and where it is (a box in its own frame and sceneFromInstance). It sits in a
+// hierarchy as a node without children: links reach it, its intensity is what its phase
+// function makes of the light arriving on it, rays through it are attenuated by τ, and
+// nothing is refined into it, nor does it link to itself (its phase function holds its
+// inner scattering).
+#pragma once
+
+#include <glm/glm.hpp>
+#include <memory>
+#include <string>
+
+#include "solver/raytrace/occlusion.h"
+#include "solver/scene/scene.h"
+
+namespace leaflux {
+
+class ClosedContents {
+  public:
+    virtual ~ClosedContents() = default;
+    // τ(ω): the fraction of parallel light along unit ω (instance frame) that crosses the
+    // box without meeting the structure.
+    virtual double Transmittance(const glm::dvec3& omega) const = 0;
+    // f(ωi, ωo) in band b: the intensity (W/sr) leaving towards unit ωo per unit irradiance
+    // (W/m², normal to the beam) arriving from unit ωi (towards the source), both in the
+    // instance frame. It holds the structure's area intercepting ωi and every scattering
+    // inside it.
+    virtual double Phase(int band, const glm::dvec3& towardSource,
+                         const glm::dvec3& outgoing) const = 0;
+};
+
+struct ClosedNode {
+    std::string name;
+    glm::dmat4 sceneFromInstance{1.0};    // into the flat scene's local frame
+    glm::dvec3 boxMin{0.0}, boxMax{0.0};  // in the instance frame
+    double areaM2 = 0.0;                  // the structure's leaf area, one side
+    NodeId parent = kNoParent;            // the scene node it hangs under, or the top of the scene
+    std::shared_ptr<const ClosedContents> contents;
+
+    // Its box as rays see it.
+    ClosedProxy Proxy() const {
+        return {sceneFromInstance, boxMin, boxMax, [contents = contents](const glm::dvec3& omega) {
+                    return contents->Transmittance(omega);
+                }};
+    }
+    // The box's area projected along unit ω in the scene's frame, both sides together
+    // halved: Σ over its three axes of |ω · n_i| times the face's area.
+    double BoxProjectedArea(const glm::dvec3& omega) const {
+        const glm::dmat3 linear(sceneFromInstance);
+        const glm::dvec3 size = boxMax - boxMin;
+        const glm::dvec3 e[3] = {linear[0] * size.x, linear[1] * size.y, linear[2] * size.z};
+        double area = 0.0;
+        for (int i = 0; i < 3; ++i)
+            area += std::abs(glm::dot(glm::cross(e[(i + 1) % 3], e[(i + 2) % 3]), omega));
+        return area;
+    }
+    // A direction of the scene's frame in the instance's, unit.
+    glm::dvec3 ToInstance(const glm::dvec3& omega) const {
+        return glm::normalize(glm::inverse(glm::dmat3(sceneFromInstance)) * omega);
+    }
+};
+
+}  // namespace leaflux

@@ -1,0 +1,54 @@
+#include "solver/radiosity/closed_scattering.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace leaflux {
+
+double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource>& sources,
+                     const ClosedLight& arrived, Field& field) {
+    const Hierarchy& hierarchy = model.Nodes();
+    const DirectionSet& directions = model.Directions();
+    const Channels& channels = model.ChannelSet();
+    const int bins = model.BinCount(), count = channels.Count();
+    const std::size_t closedCount = hierarchy.Closed().size();
+    std::vector<double> change(closedCount, 0.0), largest(closedCount, 0.0);
+    tbb::parallel_for(std::size_t{0}, closedCount, [&](std::size_t c) {
+        const ClosedNode& closed = hierarchy.Closed()[c];
+        const ClosedContents& contents = *closed.contents;
+        const std::uint32_t n = hierarchy.NodeOfClosed(static_cast<std::int32_t>(c));
+        double* out = field.intensity[model.Slot(n)];
+        const double* fromBins = arrived.bins[c];
+        const double* fromSources = arrived.sources[c];
+        std::vector<glm::dvec3> local(bins);
+        for (int d = 0; d < bins; ++d) local[d] = closed.ToInstance(directions.Direction(d));
+        std::vector<double> power(count, 0.0);
+        for (int o = 0; o < bins; ++o) {
+            for (int k = 0; k < count; ++k) {
+                const int band = channels.BandOf(k);
+                double intensity = 0.0;
+                for (int i = 0; i < bins; ++i) {
+                    const double e = fromBins[i * count + k];
+                    if (e != 0.0) intensity += e * contents.Phase(band, local[i], local[o]);
+                }
+                for (std::size_t s = 0; s < sources.size(); ++s) {
+                    const double e = fromSources[s] * sources[s].normalIrradiance[k];
+                    if (e != 0.0)
+                        intensity += e * contents.Phase(band, closed.ToInstance(sources[s].toward),
+                                                        local[o]);
+                }
+                change[c] = std::max(change[c], std::abs(intensity - out[o * count + k]));
+                largest[c] = std::max(largest[c], intensity);
+                out[o * count + k] = intensity;
+                power[k] += intensity * directions.HatIntegralSr(o);
+            }
+        }
+        field.emitted[n] = channels.Measure(power.data());
+    });
+    const double most = *std::max_element(largest.begin(), largest.end());
+    return most > 0.0 ? *std::max_element(change.begin(), change.end()) / most : 0.0;
+}
+
+}  // namespace leaflux
