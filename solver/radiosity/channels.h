@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 namespace leaflux {
@@ -41,6 +42,24 @@ struct Channels {
         }
         return worst;
     }
+};
+
+// Room for one value per channel, on the stack for a few channels and on the heap beyond:
+// scratch for the hot loops, which must not allocate per link.
+class ChannelScratch {
+  public:
+    explicit ChannelScratch(int count)
+        : heap_(count > kInline ? new double[count] : nullptr),
+          data_(count > kInline ? heap_.get() : inline_) {}
+    ChannelScratch(const ChannelScratch&) = delete;
+    ChannelScratch& operator=(const ChannelScratch&) = delete;
+    double* Data() { return data_; }
+
+  private:
+    static constexpr int kInline = 16;
+    double inline_[kInline];
+    std::unique_ptr<double[]> heap_;
+    double* data_;
 };
 
 // Rows of `width` values, zero when made: one row per node (or per cluster slot). Rows

@@ -35,7 +35,6 @@ void Gather(const NodeModel& model, const Field& field, const Links& links,
     const int bins = model.BinCount();
     using Range = tbb::blocked_range<std::size_t>;
     tbb::parallel_for(Range(0, receivers.size()), [&](const Range& range) {
-        std::vector<double> sent(channels);
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
             const std::uint32_t r = receivers[i];
             const HrcNode& R = hierarchy[r];
@@ -65,25 +64,29 @@ void Gather(const NodeModel& model, const Field& field, const Links& links,
                     }
                     continue;
                 }
-                Sent(link, field, model.Slot(link.sender), channels, sent.data());
                 const double geometric = transfer[0];
+                const std::uint32_t slot = model.Slot(link.sender);
                 if (plane) {
                     const double cosine = glm::dot(R.normal, toSender);
                     double* side = cosine > 0.0 ? upper : lower;
-                    for (int k = 0; k < channels; ++k) {
-                        const double normal = sent[k] * geometric;  // W/m² facing the sender
+                    ForEachSent(link, field, slot, channels, [&](int k, double sent) {
+                        const double normal = sent * geometric;  // W/m² facing the sender
                         side[k] += normal * std::abs(cosine);
                         if constexpr (kDirections) {
                             integral[k] += normal;
                             moment[k] += normal * toSender;
                         }
-                    }
+                    });
                 } else {
+                    double* at[3];
+                    double weight[3];
                     for (int j = 0; j < 3; ++j) {
-                        double* at = bin + link.receiverBins.index[j] * channels;
-                        const double weight = link.receiverBins.Weight(j) * geometric;
-                        for (int k = 0; k < channels; ++k) at[k] += weight * sent[k];
+                        at[j] = bin + link.receiverBins.index[j] * channels;
+                        weight[j] = link.receiverBins.Weight(j) * geometric;
                     }
+                    ForEachSent(link, field, slot, channels, [&](int k, double sent) {
+                        for (int j = 0; j < 3; ++j) at[j][k] += weight[j] * sent;
+                    });
                 }
             }
         }

@@ -74,20 +74,28 @@ struct NodeLink {
     bool Carries() const { return transfer != std::array<float, 3>{}; }
 };
 
-// What a link's sender sends towards its receiver, per channel, into `sent`: the radiosity
-// of a plane's side, the intensity of a cluster (`slot`: the sender's, NodeModel::Slot).
-inline void Sent(const NodeLink& link, const Field& field, std::uint32_t slot, int channels,
-                 double* sent) {
+// What a link's sender sends towards its receiver, channel by channel: f(k, light) for
+// each channel k, the radiosity of a plane's side or the intensity of a cluster
+// interpolated between its bins (`slot`: the sender's, NodeModel::Slot).
+template <class F>
+inline void ForEachSent(const NodeLink& link, const Field& field, std::uint32_t slot, int channels,
+                        F&& f) {
     if (link.senderPlane) {
-        std::copy_n(field.radiosity(link.sender, link.senderSide), channels, sent);
+        const double* radiosity = field.radiosity(link.sender, link.senderSide);
+        for (int k = 0; k < channels; ++k) f(k, radiosity[k]);
         return;
     }
-    std::fill_n(sent, channels, 0.0);
     const double* in = field.intensity[slot];
-    for (int j = 0; j < 3; ++j) {
-        const double* bin = in + link.senderBins.index[j] * channels;
-        const double weight = link.senderBins.Weight(j);
-        for (int k = 0; k < channels; ++k) sent[k] += weight * bin[k];
+    const double* bins[3] = {in + link.senderBins.index[0] * channels,
+                             in + link.senderBins.index[1] * channels,
+                             in + link.senderBins.index[2] * channels};
+    const double weights[3] = {link.senderBins.Weight(0), link.senderBins.Weight(1),
+                               link.senderBins.Weight(2)};
+    for (int k = 0; k < channels; ++k) {
+        double sent = weights[0] * bins[0][k];
+        sent += weights[1] * bins[1][k];
+        sent += weights[2] * bins[2][k];
+        f(k, sent);
     }
 }
 

@@ -182,13 +182,14 @@ double NodeModel::Power(const Field& field, std::uint32_t n, const glm::dvec3& o
         }
         return total;
     }
-    thread_local std::vector<double> sent;
-    sent.assign(channels, 0.0);
+    ChannelScratch scratch(channels);
+    double* sent = scratch.Data();
+    std::fill_n(sent, channels, 0.0);
     for (int k = 0; k < 3; ++k) {
         const double* bin = intensity + w.vertex[k] * channels;
         for (int c = 0; c < channels; ++c) sent[c] += w.weight[k] * bin[c];
     }
-    return channels_.Measure(sent.data());
+    return channels_.Measure(sent);
 }
 
 bool NodeModel::CanSplit(std::uint32_t n) const {

@@ -50,11 +50,13 @@ void PushPull::PullNode(Field& field, std::uint32_t n) const {
         // cluster's intensity, below, is for the clusters above it.
         for (int s : {kUpper, kLower}) {
             double* mean = field.radiosity(n, s);
-            std::fill_n(mean, channels, 0.0);
+            bool first = true;  // 0 + x is x: the first part is assigned
             for (std::uint32_t child : node.children) {
                 const double share = hierarchy_[child].areaM2 / node.areaM2;
                 const double* part = field.radiosity(child, s);
-                for (int c = 0; c < channels; ++c) mean[c] += share * part[c];
+                for (int c = 0; c < channels; ++c)
+                    mean[c] = first ? share * part[c] : mean[c] + share * part[c];
+                first = false;
             }
         }
         if (node.patch) return;

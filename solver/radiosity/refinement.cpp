@@ -225,10 +225,17 @@ double Refiner::LinkError(const NodeLink& link, double spread) const {
     double power = field_.emitted[s];
     if (link.reach >= 0.0f) {
         const Channels& channels = model_.ChannelSet();
-        thread_local std::vector<double> sent;
-        sent.resize(channels.Count());
-        Sent(link, field_, model_.Slot(s), channels.Count(), sent.data());
-        const double light = channels.Measure(sent.data());
+        double light = 0.0;
+        if (channels.measure == ChannelMeasure::kSum || channels.beams == 1) {
+            ForEachSent(link, field_, model_.Slot(s), channels.Count(),
+                        [&](int, double sent) { light += sent; });
+        } else {
+            ChannelScratch scratch(channels.Count());
+            double* sent = scratch.Data();
+            ForEachSent(link, field_, model_.Slot(s), channels.Count(),
+                        [&](int k, double value) { sent[k] = value; });
+            light = channels.Measure(sent);
+        }
         power = static_cast<double>(link.reach) * light;
         if (!link.exact) power = std::min(power, field_.emitted[s]);
     }

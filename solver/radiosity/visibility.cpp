@@ -22,15 +22,11 @@ struct Exclusion {
 };
 }  // namespace
 
-double LinkVisibility::Brightness(const Hierarchy::Point& q, const glm::dvec3& towardQ) const {
-    if (q.closed >= 0) {
-        // A closed instance's radiance towards the ray: its intensity over its area seen.
-        const std::uint32_t n = hierarchy_.NodeOfClosed(q.closed);
-        const double area = model_.ProjectedArea(n, -towardQ);
-        return area > 0.0 ? model_.Power(field_, n, -towardQ) / area : 0.0;
-    }
-    return model_.SideRadiosity(field_, hierarchy_.PatchOf(q.triangle),
-                                glm::dot(q.normal, towardQ) < 0.0 ? kUpper : kLower);
+double LinkVisibility::ClosedBrightness(std::int32_t closed, const glm::dvec3& towardQ) const {
+    // A closed instance's radiance towards the ray: its intensity over its area seen.
+    const std::uint32_t n = hierarchy_.NodeOfClosed(closed);
+    const double area = model_.ProjectedArea(n, -towardQ);
+    return area > 0.0 ? model_.Power(field_, n, -towardQ) / area : 0.0;
 }
 
 Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
@@ -38,6 +34,7 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std:
     Random random(StreamSeed(static_cast<std::uint64_t>(set), r, s));
     const int count = visibilityRays_;
     const bool fromCluster = !hierarchy_[s].patch;
+    const bool boxes = occlusion_.ProxyCount() > 0;
     double visible = 0.0, total = 0.0, visibleLight = 0.0, totalLight = 0.0;
     int traced = 0;
     double passed = 0.0;
@@ -57,9 +54,18 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std:
         ++rays, ++traced;
         total += weight;
         totalLight += light;
+        const RayStart start{p.position, p.triangle};
+        const double length = distance * (1.0 - 1e-4);
+        if (!boxes) {  // triangles alone: a ray passes or not
+            if (occlusion_.Triangles().Occluded(start, d / distance, length)) continue;
+            visible += weight;
+            visibleLight += light;
+            passed += 1.0;
+            continue;
+        }
         const std::int32_t ends[2] = {p.closed, q.closed};
-        const double through = occlusion_.Transmittance({p.position, p.triangle}, d / distance,
-                                                        distance * (1.0 - 1e-4), Exclusion(ends));
+        const double through =
+            occlusion_.Transmittance(start, d / distance, length, Exclusion(ends));
         visible += weight * through;
         visibleLight += light * through;
         passed += through;

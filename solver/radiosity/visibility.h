@@ -84,7 +84,12 @@ class LinkVisibility {
   private:
     // What a sender's point q sends towards the ray (from the receiver, towardQ), all
     // channels: the radiosity of a patch's side facing it, a closed instance's radiance.
-    double Brightness(const Hierarchy::Point& q, const glm::dvec3& towardQ) const;
+    double Brightness(const Hierarchy::Point& q, const glm::dvec3& towardQ) const {
+        if (q.closed >= 0) return ClosedBrightness(q.closed, towardQ);
+        return model_.SideRadiosity(field_, hierarchy_.PatchOf(q.triangle),
+                                    glm::dot(q.normal, towardQ) < 0.0 ? kUpper : kLower);
+    }
+    double ClosedBrightness(std::int32_t closed, const glm::dvec3& towardQ) const;
 
     const Hierarchy& hierarchy_;
     const NodeModel& model_;

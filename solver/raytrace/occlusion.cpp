@@ -119,10 +119,8 @@ Occlusion::~Occlusion() {
     if (scene_) rtcReleaseScene(scene_);
 }
 
-double Occlusion::Transmittance(const RayStart& start, const glm::dvec3& direction,
-                                double maxDistance, std::span<const std::uint32_t> exclude) const {
-    if (triangles_.Occluded(start, direction, maxDistance)) return 0.0;
-    if (boxes_.empty()) return 1.0;
+double Occlusion::ThroughBoxes(const RayStart& start, const glm::dvec3& direction,
+                               double maxDistance, std::span<const std::uint32_t> exclude) const {
     ProxyQuery query;
     rtcInitIntersectContext(&query.context);
     query.occlusion = this;

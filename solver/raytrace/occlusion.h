@@ -55,7 +55,10 @@ class Occlusion {
     // open around them).
     double Transmittance(const RayStart& start, const glm::dvec3& direction,
                          double maxDistance = std::numeric_limits<double>::infinity(),
-                         std::span<const std::uint32_t> exclude = {}) const;
+                         std::span<const std::uint32_t> exclude = {}) const {
+        if (triangles_.Occluded(start, direction, maxDistance)) return 0.0;
+        return boxes_.empty() ? 1.0 : ThroughBoxes(start, direction, maxDistance, exclude);
+    }
 
     std::size_t ProxyCount() const { return proxies_.size(); }
     const RayScene& Triangles() const { return triangles_; }
@@ -67,6 +70,9 @@ class Occlusion {
         glm::dvec3 lower, upper;  // bounds in the ray scene's frame
     };
     friend struct ProxyQuery;
+    // The product of τ along a segment that no triangle blocks.
+    double ThroughBoxes(const RayStart& start, const glm::dvec3& direction, double maxDistance,
+                        std::span<const std::uint32_t> exclude) const;
     static void Bounds(const RTCBoundsFunctionArguments* args);
     static void Crossed(const RTCOccludedFunctionNArguments* args);
     static void CrossedIntersect(const RTCIntersectFunctionNArguments* args);
