@@ -1,4 +1,5 @@
 // Line-oriented importers: Wavefront OBJ and the Caribu formats (.can, .opt, .light).
+// Errors name the file and line; faces that carry no light follow solver/io/unlit.h.
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -6,6 +7,7 @@
 #include <sstream>
 
 #include "solver/io/importers.h"
+#include "solver/io/unlit.h"
 #include "solver/util/error.h"
 
 namespace leaflux {
@@ -28,6 +30,22 @@ double ReadNumber(std::istringstream& in, const std::string& path, int line, con
     return value;
 }
 
+// A vertex, each coordinate within kMaxCoordinateM.
+glm::dvec3 ReadVertex(std::istringstream& in, const std::string& path, int line, const char* what) {
+    glm::dvec3 v;
+    const char* axes[] = {"x", "y", "z"};
+    for (int k = 0; k < 3; ++k) {
+        const std::string name = std::string(what) + " " + axes[k];
+        v[k] = ReadNumber(in, path, line, name.c_str());
+        if (std::abs(v[k]) > kMaxCoordinateM) {
+            std::ostringstream text;
+            text << name << " = " << v[k] << " is out of range (at most 1e6 in magnitude)";
+            ParseError(path, line, text.str());
+        }
+    }
+    return v;
+}
+
 NodeType TypeFromName(std::string name) {
     std::transform(name.begin(), name.end(), name.begin(), ::tolower);
     if (name.find("leaf") != std::string::npos) return NodeType::kLeaf;
@@ -41,6 +59,7 @@ NodeType TypeFromName(std::string name) {
 // Builds organs as faces arrive; vertices are shared file-wide, copied per organ.
 class ObjOrgans {
   public:
+    explicit ObjOrgans(UnlitGeometry& unlit) : unlit_(unlit) {}
     void Start(const std::string& group, const std::string& material) {
         group_ = group;
         material_ = material;
@@ -52,7 +71,7 @@ class ObjOrgans {
         // A second material in a group starts a new organ.
         if (current_ >= 0) current_ = -1, split_ = true;
     }
-    void Face(const std::vector<glm::dvec3>& vertices, const std::vector<int>& indices) {
+    void Face(const std::vector<glm::dvec3>& vertices, const std::vector<int>& indices, int line) {
         if (current_ < 0) {
             std::string name = group_.empty() ? "object" : group_;
             if (split_) name += "/" + material_;
@@ -74,9 +93,8 @@ class ObjOrgans {
             if (added) mesh.positions.push_back(vertices[index]);
             local.push_back(it->second);
         }
-        for (std::size_t k = 1; k + 1 < local.size(); ++k) {
-            mesh.triangles.push_back({local[0], local[k], local[k + 1]});
-        }
+        const Node& organ = organs_[current_];
+        unlit_.AddPolygon(mesh, local, line, organ.name, organ.id);
     }
     std::vector<Node> Take() { return std::move(organs_); }
 
@@ -85,6 +103,7 @@ class ObjOrgans {
         const int seen = names_[name]++;
         return seen == 0 ? name : name + "#" + std::to_string(seen + 1);
     }
+    UnlitGeometry& unlit_;
     std::string group_, material_;
     int current_ = -1;
     std::shared_ptr<Mesh> mesh_;  // the current organ's, still being filled
@@ -96,21 +115,18 @@ class ObjOrgans {
 
 }  // namespace
 
-ImportedGeometry ReadObj(const std::string& path) {
+ImportedGeometry ReadObj(const std::string& path, const ImportOptions& options) {
     std::ifstream in = Open(path);
+    UnlitGeometry unlit(path, options);
     std::vector<glm::dvec3> vertices;
-    ObjOrgans organs;
+    ObjOrgans organs(unlit);
     std::string text;
     for (int line = 1; std::getline(in, text); ++line) {
         std::istringstream fields(text);
         std::string keyword;
         if (!(fields >> keyword) || keyword[0] == '#') continue;
         if (keyword == "v") {
-            glm::dvec3 v;
-            v.x = ReadNumber(fields, path, line, "vertex x");
-            v.y = ReadNumber(fields, path, line, "vertex y");
-            v.z = ReadNumber(fields, path, line, "vertex z");
-            vertices.push_back(v);
+            vertices.push_back(ReadVertex(fields, path, line, "vertex"));
         } else if (keyword == "o" || keyword == "g") {
             std::string name;
             std::getline(fields >> std::ws, name);
@@ -135,21 +151,28 @@ ImportedGeometry ReadObj(const std::string& path) {
                 indices.push_back(resolved);
             }
             if (indices.size() < 3) ParseError(path, line, "a face needs at least 3 vertices");
-            organs.Face(vertices, indices);
+            organs.Face(vertices, indices, line);
         }
         // vt, vn, s, mtllib and the rest carry nothing leaflux uses.
     }
     ImportedGeometry result;
     result.nodes = organs.Take();
-    if (result.nodes.empty()) ParseError(path, 0, "no face in the file");
+    if (result.nodes.empty()) throw InputError(ErrorCode::kParse, path, "no face in the file");
+    unlit.Finish(result);
     return result;
 }
 
-ImportedGeometry ReadCan(const std::string& path) {
+ImportedGeometry ReadCan(const std::string& path, const ImportOptions& options) {
     std::ifstream in = Open(path);
+    UnlitGeometry unlit(path, options);
     ImportedGeometry result;
-    // (plant, organ) → index in result.nodes; plant → its node id.
-    std::map<std::pair<long, long>, std::shared_ptr<Mesh>> organMeshes;
+    // (plant, organ) → its mesh, node id and name; plant → its node id.
+    struct OrganMesh {
+        std::shared_ptr<Mesh> mesh;
+        NodeId id = 0;
+        std::string name;
+    };
+    std::map<std::pair<long, long>, OrganMesh> organMeshes;
     std::map<long, NodeId> plantIds;
     auto soil = std::make_shared<Mesh>();
     std::string text;
@@ -179,14 +202,12 @@ ImportedGeometry ReadCan(const std::string& path) {
         if (!(fields >> count) || count < 3)
             ParseError(path, line, "a polygon needs 3 or more vertices");
         std::vector<glm::dvec3> polygon(count);
-        for (glm::dvec3& v : polygon) {
-            v.x = ReadNumber(fields, path, line, "x");
-            v.y = ReadNumber(fields, path, line, "y");
-            v.z = ReadNumber(fields, path, line, "z");
-        }
+        for (glm::dvec3& v : polygon) v = ReadVertex(fields, path, line, "vertex");
         Mesh* mesh = soil.get();
+        std::string organName = "soil";
+        std::optional<NodeId> organId;
         if (species != 0) {
-            auto [at, added] = organMeshes.emplace(std::make_pair(plant, organ), nullptr);
+            auto [at, added] = organMeshes.emplace(std::make_pair(plant, organ), OrganMesh{});
             if (added) {
                 auto [plantAt, newPlant] = plantIds.emplace(plant, 0);
                 if (newPlant) {
@@ -203,20 +224,26 @@ ImportedGeometry ReadCan(const std::string& path) {
                 node.name = "plant" + std::to_string(plant) + "_organ" + std::to_string(organ);
                 const std::string material =
                     "species" + std::to_string(species) + (organ == 0 ? "_stem" : "");
-                at->second = std::make_shared<Mesh>();
-                node.organ = Organ{at->second, material};
+                at->second.mesh = std::make_shared<Mesh>();
+                at->second.id = node.id;
+                at->second.name = node.name;
+                node.organ = Organ{at->second.mesh, material};
                 result.nodes.push_back(std::move(node));
             }
-            mesh = at->second.get();
+            mesh = at->second.mesh.get();
+            organName = at->second.name;
+            organId = at->second.id;
         }
         const auto first = static_cast<unsigned>(mesh->positions.size());
         mesh->positions.insert(mesh->positions.end(), polygon.begin(), polygon.end());
-        for (int k = 1; k + 1 < count; ++k) {
-            mesh->triangles.push_back({first, first + k, first + k + 1});
-        }
+        std::vector<unsigned> corners(count);
+        for (int k = 0; k < count; ++k) corners[k] = first + k;
+        unlit.AddPolygon(*mesh, corners, line, organName, organId);
     }
-    if (!soil->triangles.empty()) result.environment.push_back({"soil", soil, "soil"});
-    if (result.nodes.empty() && result.environment.empty()) ParseError(path, 0, "no polygon");
+    if (!soil->positions.empty()) result.environment.push_back({"soil", soil, "soil"});
+    if (result.nodes.empty() && result.environment.empty())
+        throw InputError(ErrorCode::kParse, path, "no polygon in the file");
+    unlit.Finish(result);
     return result;
 }
 
