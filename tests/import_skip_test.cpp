@@ -202,7 +202,7 @@ TEST(ObjSkip, ZeroAreaFacesAreSkippedByLineAndStrictRefusesThem) {
     EXPECT_FALSE(g.nodes[1].organ);
     std::vector<std::string> where;
     for (const SkippedGeometry& s : g.skipped) where.push_back(s.where);
-    EXPECT_EQ(where, (std::vector<std::string>{path + ":9", path + ":10", path + ":11",
+    ASSERT_EQ(where, (std::vector<std::string>{path + ":9", path + ":10", path + ":11",
                                                path + ":13", path}));
     EXPECT_EQ(g.skipped[2].reason, "triangle 2 of the face has zero area");
     const InputError strict = ErrorOf([&] { ReadObj(path, ImportOptions{true}); });
@@ -230,7 +230,7 @@ TEST(CanSkip, ZeroAreaPolygonsAreSkippedByLineAndStrictRefusesThem) {
     EXPECT_EQ(g.environment[0].mesh->triangles.size(), 2u);
     std::vector<std::string> where;
     for (const SkippedGeometry& s : g.skipped) where.push_back(s.where);
-    EXPECT_EQ(where, (std::vector<std::string>{path + ":2", path + ":3", path + ":4", path}));
+    ASSERT_EQ(where, (std::vector<std::string>{path + ":2", path + ":3", path + ":4", path}));
     EXPECT_EQ(g.skipped[0].name, "plant1_organ1");
     EXPECT_EQ(g.skipped[2].name, "soil");
     const InputError strict = ErrorOf([&] { ReadCan(path, ImportOptions{true}); });
