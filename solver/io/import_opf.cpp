@@ -53,11 +53,17 @@ class OpfReader {
     }
 
   private:
-    // "file:line" of a byte offset, or of an element.
+    // "file:line" of a byte offset, or of an element. The line starts are found once, on
+    // the first call: a file with thousands of skipped organs names each line.
     std::string At(std::size_t offset) const {
-        const auto end =
-            text_.begin() + static_cast<std::ptrdiff_t>(std::min(offset, text_.size()));
-        return path_ + ":" + std::to_string(1 + std::count(text_.begin(), end, '\n'));
+        if (lineStarts_.empty()) {
+            lineStarts_.push_back(0);
+            for (std::size_t i = 0; i < text_.size(); ++i) {
+                if (text_[i] == '\n') lineStarts_.push_back(i + 1);
+            }
+        }
+        const auto after = std::upper_bound(lineStarts_.begin(), lineStarts_.end(), offset);
+        return path_ + ":" + std::to_string(after - lineStarts_.begin());
     }
     std::string At(const pugi::xml_node node) const {
         const std::ptrdiff_t offset = node.offset_debug();
@@ -308,6 +314,7 @@ class OpfReader {
 
     std::string path_;
     std::string text_;
+    mutable std::vector<std::size_t> lineStarts_;  // offsets where lines begin, built by At
     pugi::xml_document document_;
     UnlitGeometry unlit_;
     std::map<long long, std::shared_ptr<const Mesh>> meshes_;      // by mesh Id

@@ -4,6 +4,7 @@
 // and a 20-triangle leaf in meshBDD, placed by each organ's `mat`); its triangle count is
 // that of the placed organs. Prints a table and writes CSV.
 // Run: build/release/tests/leaflux_bench_import [out.csv] [largest triangle count, 1e6]
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -83,7 +84,8 @@ void WriteOpfMesh(std::FILE* out, int id, const std::vector<double>& xyz,
 
 // One organ's node: rows of [R·S | t] in centimetres, as AMAPStudio writes them.
 void WriteOpfOrgan(std::FILE* out, const char* element, const char* opfClass, long id, int shape,
-                   const double (&m)[12], double lengthM, double widthM, int depth) {
+                   const double (&m)[12], double lengthM, double widthM, int depth,
+                   bool nanDiameter = false) {
     const std::string tab(static_cast<std::size_t>(depth), '\t');
     std::fprintf(out, "%s<%s class=\"%s\" scale=\"3\" id=\"%ld\">\n", tab.c_str(), element,
                  opfClass, id);
@@ -96,14 +98,17 @@ void WriteOpfOrgan(std::FILE* out, const char* element, const char* opfClass, lo
         std::fprintf(out, "%s\t\t\t%.7g %.7g %.7g %.7g\n", tab.c_str(), m[4 * r], m[4 * r + 1],
                      m[4 * r + 2], m[4 * r + 3]);
     }
-    std::fprintf(out, "%s\t\t</mat>\n%s\t\t<dUp>%.7g</dUp>\n%s\t\t<dDwn>%.7g</dDwn>\n", tab.c_str(),
-                 tab.c_str(), 100 * widthM, tab.c_str(), 100 * widthM);
+    char diameter[32] = "NaN";
+    if (!nanDiameter) std::snprintf(diameter, sizeof diameter, "%.7g", 100 * widthM);
+    std::fprintf(out, "%s\t\t</mat>\n%s\t\t<dUp>%s</dUp>\n%s\t\t<dDwn>%s</dDwn>\n", tab.c_str(),
+                 tab.c_str(), diameter, tab.c_str(), diameter);
     std::fprintf(out, "%s\t</geometry>\n", tab.c_str());
 }
 
 // Axes of 50 phytomers (an internode followed by the next, a leaf in branch) radiating
-// from the plant's base; `phytomers` in all.
-void WriteOpf(const std::string& path, long phytomers) {
+// from the plant's base; `phytomers` in all. With `zeroLengthEvery` = k, every k-th
+// internode has zero length (a singular `mat`) and NaN diameters, as measured plants do.
+void WriteOpf(const std::string& path, long phytomers, long zeroLengthEvery = 0) {
     std::FILE* out = std::fopen(path.c_str(), "w");
     std::fprintf(out,
                  "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<opf version=\"2.0\" "
@@ -156,15 +161,16 @@ void WriteOpf(const std::string& path, long phytomers) {
         const long count = std::min<long>(kPhytomersPerAxis, phytomers - a * kPhytomersPerAxis);
         int depth = 4;
         for (long p = 0; p < count; ++p) {
-            const double lengthCm = 2.0 + 0.01 * static_cast<double>(p % 13);
+            const bool zero = zeroLengthEvery > 0 && (p + 1) % zeroLengthEvery == 0;
+            const double lengthCm = zero ? 0.0 : 2.0 + 0.01 * static_cast<double>(p % 13);
             const double diameterCm = 0.5;
-            const glm::dvec3 base = static_cast<double>(p) * lengthCm * along;
+            const glm::dvec3 base = 2.0 * static_cast<double>(p) * along;
             const double internode[12] = {
                 lengthCm * along.x, diameterCm * side.x, diameterCm * third.x, base.x,
                 lengthCm * along.y, diameterCm * side.y, diameterCm * third.y, base.y,
                 lengthCm * along.z, diameterCm * side.z, diameterCm * third.z, base.z};
             WriteOpfOrgan(out, p == 0 ? "decomp" : "follow", "Internode", id++, 0, internode,
-                          lengthCm / 100, diameterCm / 100, depth);
+                          lengthCm / 100, diameterCm / 100, depth, zero);
             const double turn = 2.39996 * static_cast<double>(p);
             const glm::dvec3 out1 = std::cos(turn) * side + std::sin(turn) * third;
             const glm::dvec3 leafAxis = glm::normalize(out1 + 0.3 * along);
@@ -199,7 +205,7 @@ long Triangles(const ImportedGeometry& g) {
 
 struct Row {
     std::string format;
-    long triangles, organs;
+    long triangles, organs, skipped;
     double megabytes, seconds, cpuSeconds;
 };
 
@@ -218,9 +224,13 @@ Row Measure(const std::string& format, const std::string& path, Read read) {
     }
     long organs = 0;
     for (const Node& node : g.nodes) organs += node.organ.has_value();
-    return {format, Triangles(g),
-            organs, static_cast<double>(std::filesystem::file_size(path)) / 1e6,
-            best,   bestCpu};
+    return {format,
+            Triangles(g),
+            organs,
+            static_cast<long>(g.skipped.size()),
+            static_cast<double>(std::filesystem::file_size(path)) / 1e6,
+            best,
+            bestCpu};
 }
 
 }  // namespace
@@ -232,10 +242,14 @@ int main(int argc, char** argv) {
                                       ("leaflux_import_bench_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     std::vector<Row> rows;
-    // The measured plant of the OPF report: 4,191 organs.
+    spdlog::set_level(spdlog::level::err);  // the skipped geometry's warnings, on every read
+    // The measured plant of the OPF report: 4,191 organs; then with a zero-length internode
+    // (NaN diameters) in 25.
     const std::string plant = (dir / "plant.opf").string();
     WriteOpf(plant, 4191 / 2);
-    rows.push_back(Measure("opf (plant)", plant, [](const std::string& p) { return ReadOpf(p); }));
+    rows.push_back(Measure("opf-plant", plant, [](const std::string& p) { return ReadOpf(p); }));
+    WriteOpf(plant, 4191 / 2, 25);
+    rows.push_back(Measure("opf-plant-z", plant, [](const std::string& p) { return ReadOpf(p); }));
     const long largest = argc > 2 ? std::atol(argv[2]) : 1'000'000L;
     for (long triangles : {10'000L, 100'000L, 1'000'000L}) {
         if (triangles > largest) break;
@@ -255,17 +269,22 @@ int main(int argc, char** argv) {
 
     const char* path = argc > 1 ? argv[1] : "import_bench.csv";
     std::ofstream csv(path);
-    csv << "format,triangles,organs,file_mb,read_s,cpu_s,mb_per_s,mtriangles_per_s\n";
-    std::printf("%-12s %10s %8s %9s %9s %9s %8s %10s\n", "format", "triangles", "organs", "file_MB",
-                "read_s", "cpu_s", "MB/s", "Mtri/s");
+    csv << "format,triangles,organs,skipped,file_mb,read_s,cpu_s,mb_per_s,mtriangles_per_s\n";
+    std::printf("%-12s %10s %8s %8s %9s %9s %9s %8s %10s\n", "format", "triangles", "organs",
+                "skipped", "file_MB", "read_s", "cpu_s", "MB/s", "Mtri/s");
     for (const Row& r : rows) {
         const double mbps = r.megabytes / r.seconds;
         const double mtps = static_cast<double>(r.triangles) / r.seconds / 1e6;
-        csv << r.format << ',' << r.triangles << ',' << r.organs << ',' << r.megabytes << ','
-            << r.seconds << ',' << r.cpuSeconds << ',' << mbps << ',' << mtps << '\n';
-        std::printf("%-12s %10ld %8ld %9.2f %9.4f %9.4f %8.1f %10.2f\n", r.format.c_str(),
-                    r.triangles, r.organs, r.megabytes, r.seconds, r.cpuSeconds, mbps, mtps);
+        csv << r.format << ',' << r.triangles << ',' << r.organs << ',' << r.skipped << ','
+            << r.megabytes << ',' << r.seconds << ',' << r.cpuSeconds << ',' << mbps << ',' << mtps
+            << '\n';
+        std::printf("%-12s %10ld %8ld %8ld %9.2f %9.4f %9.4f %8.1f %10.2f\n", r.format.c_str(),
+                    r.triangles, r.organs, r.skipped, r.megabytes, r.seconds, r.cpuSeconds, mbps,
+                    mtps);
     }
-    std::printf("CSV: %s\n", path);
+    std::printf(
+        "opf-plant-z: the plant with every 25th internode of zero length, NaN diameters\n"
+        "opf: triangles placed by organs sharing a 48- and a 20-triangle mesh\nCSV: %s\n",
+        path);
     return 0;
 }
