@@ -185,6 +185,58 @@ suns { direction { x: 0 y: 0 z: 1 } normal_irradiance { key: "PAR" value: 400 } 
     EXPECT_EQ(leaves, 2);
 }
 
+// Two organs share a mesh of a horizontal and a vertical triangle; the frame of the second
+// flattens the vertical one (z scaled by 1e-12, still invertible); a third has a NaN in its
+// frame.
+std::string FlatteningFrames() {
+    const auto organ = [](int id, const std::string& mat) {
+        return "<decomp class=\"Leaf\" scale=\"3\" id=\"" + std::to_string(id) +
+               "\">\n<geometry class=\"Mesh\">\n<shapeIndex>0</shapeIndex>\n<mat>\n" + mat +
+               "\n</mat>\n</geometry>\n</decomp>\n";
+    };
+    return "<opf version=\"2.0\">\n<meshBDD>\n<mesh Id=\"0\">\n"
+           "<points>0 0 0  1 0 0  0 1 0  0 0 1</points>\n"
+           "<faces><face Id=\"0\">0 1 2</face><face Id=\"1\">0 1 3</face></faces>\n"
+           "</mesh>\n</meshBDD>\n<shapeBDD><shape Id=\"0\"><meshIndex>0</meshIndex>"
+           "<materialIndex>0</materialIndex></shape></shapeBDD>\n"
+           "<topology class=\"Plant\" scale=\"1\" id=\"1\">\n" +
+           organ(2, "1 0 0 0\n0 1 0 0\n0 0 1 0") + organ(3, "1 0 0 5\n0 1 0 0\n0 0 1e-12 0") +
+           organ(4, "1 0 0 9\n0 NaN 0 0\n0 0 1 0") + "</topology>\n</opf>\n";
+}
+
+TEST(OpfSkip, AFrameThatFlattensPartOfASharedMeshCopiesItForThatOrganOnly) {
+    const std::string path = TemporaryFile("flattening.opf", FlatteningFrames());
+    const ImportedGeometry g = ReadOpf(path);
+    const Node& upright = NodeWithId(g, 2);
+    const Node& flattened = NodeWithId(g, 3);
+    ASSERT_TRUE(upright.organ && flattened.organ);
+    EXPECT_EQ(upright.organ->mesh->triangles.size(), 2u);
+    EXPECT_EQ(upright.organ->mesh->name, "meshBDD mesh 0");  // still the shared mesh
+    ASSERT_EQ(flattened.organ->mesh->triangles.size(), 1u);  // its own copy
+    EXPECT_NE(flattened.organ->mesh, upright.organ->mesh);
+    EXPECT_EQ(flattened.organ->mesh->triangles[0], glm::uvec3(0, 1, 2));
+    EXPECT_FALSE(NodeWithId(g, 4).organ);
+    ASSERT_EQ(g.skipped.size(), 2u);
+    EXPECT_EQ(g.skipped[0].node, 4u);  // read first: the NaN frame
+    EXPECT_EQ(g.skipped[0].reason, "<mat> is not finite");
+    EXPECT_EQ(g.skipped[1].node, 3u);
+    EXPECT_EQ(g.skipped[1].triangles, 1u);
+    EXPECT_EQ(ErrorOf([&] { ReadOpf(path, ImportOptions{true}); }).Node(), 4u);
+}
+
+TEST(SkippedSummary, NamesTheFirstTenAndCountsTheRest) {
+    std::vector<SkippedGeometry> skipped;
+    for (NodeId id = 1; id <= 12; ++id)
+        skipped.push_back({"p.opf:" + std::to_string(10 * id), id, "Leaf" + std::to_string(id),
+                           "dUp is NaN", 20});
+    const std::string text = SkippedSummary("p.opf", skipped);
+    EXPECT_EQ(text.rfind("p.opf: skipped 240 triangles that carry no light, in 12 organs", 0), 0u)
+        << text;
+    EXPECT_NE(text.find("node 10 Leaf10 at line 100: dUp is NaN; and 2 more"), std::string::npos)
+        << text;
+    EXPECT_EQ(text.find("Leaf11"), std::string::npos) << text;
+}
+
 TEST(ObjSkip, ZeroAreaFacesAreSkippedByLineAndStrictRefusesThem) {
     const std::string text =
         "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 2 0 0\nv 0 1 0\nv 2 2 0\n"  // lines 1-6
