@@ -158,18 +158,21 @@ void ValidateMesh(const Mesh* mesh, const glm::dmat4& worldFromLocal, const std:
                   std::optional<NodeId> node) {
     if (mesh == nullptr)
         throw InputError(ErrorCode::kInvalidArgument, organField, "has no mesh", node);
-    const std::string field = mesh->name.empty() ? organField : mesh->name;
-    const std::string placed = mesh->name.empty() || !node ? ""
-                                                           : " (shared mesh, as placed by node " +
-                                                                 std::to_string(*node) + ")";
+    // Built only on failure: this runs once per organ.
+    const auto field = [&] { return mesh->name.empty() ? organField : mesh->name; };
+    const auto placed = [&] {
+        return mesh->name.empty() || !node
+                   ? std::string()
+                   : " (shared mesh, as placed by node " + std::to_string(*node) + ")";
+    };
     if (mesh->triangles.empty()) {
-        throw InputError(ErrorCode::kDegenerate, field + ".triangles", "mesh has no triangle",
+        throw InputError(ErrorCode::kDegenerate, field() + ".triangles", "mesh has no triangle",
                          node);
     }
     for (std::size_t i = 0; i < mesh->positions.size(); ++i) {
         if (!Finite(mesh->positions[i])) {
             throw InputError(ErrorCode::kInvalidArgument,
-                             field + ".positions[" + std::to_string(i) + "]", "is not finite",
+                             field() + ".positions[" + std::to_string(i) + "]", "is not finite",
                              node);
         }
     }
@@ -181,8 +184,8 @@ void ValidateMesh(const Mesh* mesh, const glm::dmat4& worldFromLocal, const std:
     for (std::size_t t = 0; t < mesh->triangles.size(); ++t) {
         const glm::uvec3& tri = mesh->triangles[t];
         const auto fail = [&](ErrorCode code, const std::string& message) {
-            throw InputError(code, field + ".triangles[" + std::to_string(t) + "]",
-                             message + placed, node);
+            throw InputError(code, field() + ".triangles[" + std::to_string(t) + "]",
+                             message + placed(), node);
         };
         if (tri.x >= vertexCount || tri.y >= vertexCount || tri.z >= vertexCount) {
             fail(ErrorCode::kInvalidArgument,
