@@ -10,7 +10,7 @@ packages=(
     libprotobuf-dev protobuf-compiler
     libspdlog-dev libfmt-dev
     libgtest-dev libgmock-dev libbenchmark-dev
-    libsqlite3-dev libcli11-dev
+    libsqlite3-dev libcli11-dev libpugixml-dev
     python3 python3-zmq python3-protobuf python3-matplotlib python3-numpy
 )
 

@@ -23,13 +23,17 @@
 namespace leaflux {
 namespace {
 
+constexpr const char* kStrictHelp =
+    "Refuse imported files holding geometry that carries no light (zero-area faces, "
+    "zero-length organs, NaN diameters) instead of skipping it with a warning";
+
 struct SolveCommand {
     std::string scene, solver = "mc", out, structures, ply;
     int samples = 1024, replicates = 16, threads = 0;
     double epsilon = 1e-4;
     HrcOptions hrc;  // subdivision, rays and directions; ε and threads are set apart
     std::uint64_t seed = 1;
-    bool directOnly = false, quiet = false;
+    bool directOnly = false, quiet = false, strict = false;
 };
 
 // HRC's settings besides ε, as options named `prefix` + name, their help after `label`.
@@ -61,7 +65,7 @@ void AddHrcSettings(CLI::App& app, HrcOptions& hrc, const std::string& prefix,
 
 int RunSolve(const SolveCommand& command) {
     const auto start = std::chrono::steady_clock::now();
-    const Scene scene = LoadSceneFile(command.scene);
+    const Scene scene = LoadSceneFile(command.scene, ImportOptions{command.strict});
     PreparedScene prepared(scene);
     SolverSettings settings;
     settings.monteCarlo.samplesPerReceiver = command.samples;
@@ -195,7 +199,7 @@ struct ClientCommand {
     std::string endpoint = "tcp://127.0.0.1:5555", scene, session, delta, solver = "hrc";
     std::string curveServerKeyFile;
     std::int64_t number = 1;
-    bool leaves = true, structures = false;
+    bool leaves = true, structures = false, strict = false;
     double epsilon = 1e-4;
     int timeoutS = 600;
 };
@@ -228,7 +232,8 @@ int RunClient(const ClientCommand& command, const v1::Request& request) {
 v1::Request OpenFromFile(const ClientCommand& command) {
     // The scene file's imports are read here: the daemon reads no files.
     v1::Request request;
-    *request.mutable_open_session()->mutable_scene() = ToProto(LoadSceneFile(command.scene));
+    *request.mutable_open_session()->mutable_scene() =
+        ToProto(LoadSceneFile(command.scene, ImportOptions{command.strict}));
     v1::SolverSettings* settings = request.mutable_open_session()->mutable_settings();
     settings->set_solver(command.solver == "mc" ? v1::SOLVER_KIND_MONTE_CARLO
                                                 : v1::SOLVER_KIND_HRC);
@@ -310,6 +315,7 @@ int main(int argc, char** argv) {
     solveApp->add_option("--ply", solve.ply,
                          "PLY of the triangles with the first band's irradiance");
     solveApp->add_flag("--quiet", solve.quiet, "No progress or log lines, only the summary");
+    solveApp->add_flag("--strict", solve.strict, kStrictHelp);
 
     GenerateCommand generate;
     CLI::App* generateApp =
@@ -391,6 +397,7 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     openApp->add_option("--solver", client.solver, "hrc or mc")
         ->check(CLI::IsMember({"mc", "hrc"}));
+    openApp->add_flag("--strict", client.strict, kStrictHelp);
     openApp->add_option("--epsilon", client.epsilon, "hrc: link error bound")
         ->check(CLI::Range(1e-9, 1.0));
     CLI::App* cycleApp = clientApp->add_subcommand("cycle", "Send a cycle, with a delta file");

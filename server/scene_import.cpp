@@ -1,4 +1,5 @@
-// Geometry files named by a scene's `imports`, placed into the scene.
+// Geometry files named by a scene's `imports`, placed into the scene. What the importers
+// skip (geometry that carries no light) they log; ImportOptions::strict refuses it.
 #include <algorithm>
 #include <filesystem>
 #include <set>
@@ -90,7 +91,8 @@ glm::dmat4 ImportFrame(const v1::Frame& frame, const std::string& field) {
 
 }  // namespace
 
-void ReadImports(const v1::Scene& message, Scene& scene, const std::filesystem::path& base) {
+void ReadImports(const v1::Scene& message, Scene& scene, const std::filesystem::path& base,
+                 const ImportOptions& options) {
     for (int i = 0; i < message.imports_size(); ++i) {
         const v1::Import& import = message.imports(i);
         const std::string field = "imports[" + std::to_string(i) + "]";
@@ -99,13 +101,13 @@ void ReadImports(const v1::Scene& message, Scene& scene, const std::filesystem::
         std::set<std::string> created;
         switch (FormatOf(import, field)) {
             case v1::GEOMETRY_FORMAT_OBJ:
-                geometry = ReadObj(path);
+                geometry = ReadObj(path, options);
                 break;
             case v1::GEOMETRY_FORMAT_OPF:
-                geometry = ReadOpf(path);
+                geometry = ReadOpf(path, options);
                 break;
             default:
-                geometry = ReadCan(path);
+                geometry = ReadCan(path, options);
                 if (import.can_optics_size() > 0)
                     created = AddCanOptics(import, field, base, scene);
                 break;

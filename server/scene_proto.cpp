@@ -60,13 +60,16 @@ void FrameToProto(const glm::dmat4& m, v1::Frame* frame) {
     }
 }
 
-std::shared_ptr<const Mesh> MeshFromProto(const v1::Mesh& message, const std::string& field,
-                                          std::optional<NodeId> node = std::nullopt) {
+std::shared_ptr<Mesh> MeshFromProto(const v1::Mesh& message, const std::string& field,
+                                    std::optional<NodeId> node = std::nullopt) {
     if (message.positions_size() % 3 != 0) {
-        Fail(ErrorCode::kInvalidArgument, field + ".positions", "is not x, y, z triples", node);
+        Fail(ErrorCode::kInvalidArgument, field + ".positions",
+             "holds " + std::to_string(message.positions_size()) + " numbers, not x, y, z triples",
+             node);
     }
     if (message.triangles_size() % 3 != 0) {
-        Fail(ErrorCode::kInvalidArgument, field + ".triangles", "is not index triples", node);
+        Fail(ErrorCode::kInvalidArgument, field + ".triangles",
+             "holds " + std::to_string(message.triangles_size()) + " indices, not triples", node);
     }
     auto mesh = std::make_shared<Mesh>();
     for (int i = 0; i < message.positions_size(); i += 3) {
@@ -285,15 +288,19 @@ Node NodeFromProto(const v1::Node& in, const MeshLibrary& meshes) {
 MeshLibrary MeshesFromProto(const v1::Scene& message) {
     MeshLibrary meshes;
     for (const auto& [name, mesh] : message.meshes()) {
-        meshes[name] = MeshFromProto(mesh, "meshes[" + name + "]");
+        auto shared = MeshFromProto(mesh, "meshes[" + name + "]");
+        shared->name = "meshes[" + name + "]";  // its errors name it, not the organ using it
+        meshes[name] = std::move(shared);
     }
     return meshes;
 }
 
 // Imports are in scene_import.cpp.
-void ReadImports(const v1::Scene& message, Scene& scene, const std::filesystem::path& base);
+void ReadImports(const v1::Scene& message, Scene& scene, const std::filesystem::path& base,
+                 const ImportOptions& options);
 
-Scene FromProto(const v1::Scene& message, const std::string& baseDirectory) {
+Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
+                const ImportOptions& options) {
     if (message.version() > v1::PROTOCOL_VERSION_CURRENT) {
         Fail(ErrorCode::kUnsupported, "version", "is newer than this leaflux understands");
     }
@@ -346,7 +353,7 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory) {
         const v1::PeriodicDomain& p = message.periodic();
         scene.periodic = PeriodicDomain{p.x_min(), p.y_min(), p.x_max(), p.y_max()};
     }
-    ReadImports(message, scene, base);
+    ReadImports(message, scene, base, options);
     scene.Validate();
     return scene;
 }
@@ -441,13 +448,13 @@ v1::Scene ToProto(const Scene& scene) {
     return message;
 }
 
-Scene LoadSceneFile(const std::string& path) {
+Scene LoadSceneFile(const std::string& path, const ImportOptions& options) {
     v1::Scene message;
     if (const auto error = ReadTextFormat(path, message)) {
         Fail(error->unreadable ? ErrorCode::kIo : ErrorCode::kParse, error->where,
              error->unreadable ? "cannot open the scene file" : error->what);
     }
-    return FromProto(message, std::filesystem::path(path).parent_path().string());
+    return FromProto(message, std::filesystem::path(path).parent_path().string(), options);
 }
 
 void SaveSceneFile(const Scene& scene, const std::string& path) {

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "leaflux.pb.h"
+#include "solver/io/importers.h"
 #include "solver/scene/scene.h"
 
 namespace leaflux {
@@ -24,15 +25,17 @@ Node NodeFromProto(const v1::Node& node, const MeshLibrary& meshes);
 // A sun for `scene`'s bands; `field` names it in errors.
 Sun SunFromProto(const Scene& scene, const v1::Sun& sun, const std::string& field);
 
-// `baseDirectory` resolves relative import paths (the scene file's folder).
-Scene FromProto(const v1::Scene& message, const std::string& baseDirectory);
+// `baseDirectory` resolves relative import paths (the scene file's folder); `options` say
+// what imports do with geometry that carries no light.
+Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
+                const ImportOptions& options = {});
 
 // Shared meshes stay shared: each distinct mesh is written once in `meshes`.
 v1::Scene ToProto(const Scene& scene);
 v1::NodeType TypeToProto(NodeType type);
 
 // Reads a scene file in protobuf text format; parse errors name line and column.
-Scene LoadSceneFile(const std::string& path);
+Scene LoadSceneFile(const std::string& path, const ImportOptions& options = {});
 void SaveSceneFile(const Scene& scene, const std::string& path);
 
 }  // namespace leaflux

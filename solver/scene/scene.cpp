@@ -137,41 +137,71 @@ void ValidateSources(const Scene& scene, std::set<std::string>& names) {
 
 }  // namespace
 
-// A triangle is degenerate when its area vanishes against its edges: the sine of its
-// largest angle's complement is below 1e-9 (a sliver Embree would lose in float).
-void ValidateMesh(const Mesh* mesh, const glm::dmat4& worldFromLocal, const std::string& field,
+bool CarriesLight(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+    const double twiceArea = glm::length(glm::cross(b - a, c - a));
+    const double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+    return twiceArea > 1e-9 * longest * longest && twiceArea > 1e-18;
+}
+
+bool InvertibleFrame(const glm::dmat4& frame) {
+    for (int c = 0; c < 4; ++c) {
+        for (int r = 0; r < 4; ++r) {
+            if (!std::isfinite(frame[c][r])) return false;
+        }
+    }
+    return std::abs(glm::determinant(glm::dmat3(frame))) > 1e-30;
+}
+
+// A shared mesh is named by its declaration (mesh->name) rather than by the organ that
+// happens to be checked first; the node still says which placement failed.
+void ValidateMesh(const Mesh* mesh, const glm::dmat4& worldFromLocal, const std::string& organField,
                   std::optional<NodeId> node) {
-    if (mesh == nullptr) throw InputError(ErrorCode::kInvalidArgument, field, "has no mesh", node);
+    if (mesh == nullptr)
+        throw InputError(ErrorCode::kInvalidArgument, organField, "has no mesh", node);
+    // Built only on failure: this runs once per organ.
+    const auto field = [&] { return mesh->name.empty() ? organField : mesh->name; };
+    const auto placed = [&] {
+        return mesh->name.empty() || !node
+                   ? std::string()
+                   : " (shared mesh, as placed by node " + std::to_string(*node) + ")";
+    };
     if (mesh->triangles.empty()) {
-        throw InputError(ErrorCode::kDegenerate, field + ".triangles", "mesh has no triangle",
+        throw InputError(ErrorCode::kDegenerate, field() + ".triangles", "mesh has no triangle",
                          node);
     }
     for (std::size_t i = 0; i < mesh->positions.size(); ++i) {
         if (!Finite(mesh->positions[i])) {
             throw InputError(ErrorCode::kInvalidArgument,
-                             field + ".positions[" + std::to_string(i) + "]", "is not finite",
+                             field() + ".positions[" + std::to_string(i) + "]", "is not finite",
                              node);
         }
     }
     const auto vertexCount = static_cast<unsigned>(mesh->positions.size());
+    const auto inRange = [](const glm::dvec3& p) {
+        return std::abs(p.x) <= kMaxCoordinateM && std::abs(p.y) <= kMaxCoordinateM &&
+               std::abs(p.z) <= kMaxCoordinateM;
+    };
     for (std::size_t t = 0; t < mesh->triangles.size(); ++t) {
         const glm::uvec3& tri = mesh->triangles[t];
         const auto fail = [&](ErrorCode code, const std::string& message) {
-            throw InputError(code, field + ".triangles[" + std::to_string(t) + "]", message, node);
+            throw InputError(code, field() + ".triangles[" + std::to_string(t) + "]",
+                             message + placed(), node);
         };
         if (tri.x >= vertexCount || tri.y >= vertexCount || tri.z >= vertexCount) {
             fail(ErrorCode::kInvalidArgument,
-                 "refers to a vertex beyond the " + std::to_string(vertexCount) + " positions");
+                 "refers to vertex " + std::to_string(std::max({tri.x, tri.y, tri.z})) +
+                     ", beyond the " + std::to_string(vertexCount) + " positions");
         }
         const glm::dvec3 a = glm::dvec3(worldFromLocal * glm::dvec4(mesh->positions[tri.x], 1.0));
         const glm::dvec3 b = glm::dvec3(worldFromLocal * glm::dvec4(mesh->positions[tri.y], 1.0));
         const glm::dvec3 c = glm::dvec3(worldFromLocal * glm::dvec4(mesh->positions[tri.z], 1.0));
         if (!Finite(a) || !Finite(b) || !Finite(c))
             fail(ErrorCode::kInvalidArgument, "has non-finite world coordinates");
-        const double twiceArea = glm::length(glm::cross(b - a, c - a));
-        const double longest =
-            std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
-        if (!(twiceArea > 1e-9 * longest * longest && twiceArea > 1e-18))
+        if (!inRange(a) || !inRange(b) || !inRange(c)) {
+            fail(ErrorCode::kInvalidArgument,
+                 "has a world coordinate out of range (|x|, |y|, |z| must be at most 1e6 m)");
+        }
+        if (!CarriesLight(a, b, c))
             fail(ErrorCode::kDegenerate, "has zero area (collapsed or repeated vertices)");
     }
 }
@@ -179,14 +209,16 @@ void ValidateMesh(const Mesh* mesh, const glm::dmat4& worldFromLocal, const std:
 void ValidateNode(const Scene& scene, const Node& node) {
     if (node.id == 0)
         throw InputError(ErrorCode::kInvalidArgument, "nodes.id", "0 is not a valid id");
-    for (int c = 0; c < 4; ++c) {
-        for (int r = 0; r < 4; ++r) {
-            if (!std::isfinite(node.parentFromLocal[c][r]))
-                throw InputError(ErrorCode::kInvalidArgument, "frame", "is not finite", node.id);
+    if (!InvertibleFrame(node.parentFromLocal)) {
+        for (int c = 0; c < 4; ++c) {
+            for (int r = 0; r < 4; ++r) {
+                if (!std::isfinite(node.parentFromLocal[c][r]))
+                    throw InputError(ErrorCode::kInvalidArgument, "frame", "is not finite",
+                                     node.id);
+            }
         }
-    }
-    if (!(std::abs(glm::determinant(glm::dmat3(node.parentFromLocal))) > 1e-30))
         throw InputError(ErrorCode::kDegenerate, "frame", "is singular", node.id);
+    }
     if (!std::isfinite(node.age))
         throw InputError(ErrorCode::kInvalidArgument, "age", "is not finite", node.id);
     for (const auto& [key, value] : node.attributes) {

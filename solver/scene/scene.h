@@ -39,7 +39,24 @@ struct Band {
 struct Mesh {
     std::vector<glm::dvec3> positions;
     std::vector<glm::uvec3> triangles;
+    // A shared mesh's name where it was declared ("meshes[leaf]", "meshBDD mesh 2"), so that
+    // its errors name it; empty for an organ's own mesh.
+    std::string name;
 };
+
+// World coordinates (m) beyond this are out of range: far past any canopy, and where
+// single-precision ray tracing (Embree) can no longer tell leaves apart.
+inline constexpr double kMaxCoordinateM = 1e6;
+
+// Whether a triangle, in coordinates within kMaxCoordinateM, has an area light can land on:
+// its area does not vanish against its longest edge (the sine of its largest angle's
+// complement is at least 1e-9, a sliver Embree would lose in float). The one test of
+// scene validation and of the importers' skipping (ImportOptions).
+bool CarriesLight(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
+
+// Whether a frame's 3×3 part is finite and invertible (|det| > 1e-30): a singular frame
+// flattens its mesh (a zero-length internode) and cannot be composed through.
+bool InvertibleFrame(const glm::dmat4& frame);
 
 // Diffuse properties of one band (Soler 2003 §4.3). Opaque surfaces have τ = 0.
 struct BandOptics {
