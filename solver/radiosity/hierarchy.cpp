@@ -83,6 +83,7 @@ Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat, std::span<const 
     for (const ClosedNode& node : closed_) {
         LEAFLUX_CHECK(node.parent == kNoParent || built.count(node.parent));
     }
+    ofScene_ = std::move(built);
     if (top.empty()) return;
     root_ = top.size() == 1 ? top[0] : Constrain(std::move(top));
     cumulativeArea_.push_back(0.0);

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <span>
+#include <unordered_map>
 #include <vector>
 
 #include "solver/radiosity/closed_node.h"
@@ -64,6 +65,11 @@ class Hierarchy {
 
     const std::vector<ClosedNode>& Closed() const { return closed_; }
     std::uint32_t NodeOfClosed(std::int32_t closed) const { return closedNode_[closed]; }
+    // The node a scene node became (the botanical structure's cluster), or kNoNode.
+    std::uint32_t NodeOf(NodeId id) const {
+        const auto it = ofScene_.find(id);
+        return it == ofScene_.end() ? kNoNode : it->second;
+    }
 
     // A point on the node's surfaces, area-weighted, from two uniform numbers; with the
     // flat triangle it lies on (for rays to leave it). A point of a closed instance lies in
@@ -100,7 +106,8 @@ class Hierarchy {
     const FlatScene& flat_;
     std::vector<HrcNode> nodes_;
     std::vector<ClosedNode> closed_;
-    std::vector<std::uint32_t> closedNode_;  // by closed instance: its node
+    std::vector<std::uint32_t> closedNode_;              // by closed instance: its node
+    std::unordered_map<NodeId, std::uint32_t> ofScene_;  // NodeOf
     // Flat triangles in hierarchy order, and closed instances as kClosedEntry | index.
     static constexpr std::uint32_t kClosedEntry = 0x80000000u;
     std::vector<std::uint32_t> triangleOrder_;

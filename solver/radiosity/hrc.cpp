@@ -117,6 +117,10 @@ class SceneSolve {
         return solution;
     }
 
+    // After Run: the subtree under scene node `root` solved again alone, as a local problem
+    // (hrc.h, SolveHrcThenLocal).
+    Solution RunLocal(NodeId root);
+
   private:
     void Solve(Solution& solution);
     // After refinement changed the hierarchy: the traversal and the per-node tables.
@@ -127,9 +131,21 @@ class SceneSolve {
     void OnSplit(std::uint32_t n);
     template <bool kDirections>
     void Collect() {
-        Gather<kDirections>(model_, field_, links_, traversal_.Receivers(), gathered_);
-        pushPull_.PushDown<kDirections>(links_, gathered_, sourceLight_, leafLight_, Closed());
+        Gather<kDirections>(model_, field_, *active_, traversal_.Receivers(), gathered_);
+        pushPull_.PushDown<kDirections>(*active_, gathered_, sourceLight_, leafLight_, Closed());
     }
+    // Direct light first, so that links are refined on what senders will send: the sources
+    // pushed down, one update and a pull-up.
+    void LightFromSources() {
+        pushPull_.PushSources(*active_, sources_, sourceLight_, Closed());
+        if (!options_.directOnly) {
+            pushPull_.PushDown<false>(*active_, gathered_, sourceLight_, leafLight_, Closed());
+            Update();
+        }
+        pushPull_.PullUp(field_);
+    }
+    // Jacobi from the emission, then refine–solve passes until no link needs refining.
+    void Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock);
     ClosedLight* Closed() { return hierarchy_.Closed().empty() ? nullptr : &closedLight_; }
     // The radiosity of the leaf patches and the light the closed instances send, from what
     // arrived: the largest change over the largest value.
@@ -170,13 +186,18 @@ class SceneSolve {
     Exposure exposure_;
     const Estimator estimator_;
     const LinkVisibility visibility_;
-    const PushPull pushPull_;
+    PushPull pushPull_;
     std::optional<Refiner> refiner_;
+    Thresholds thresholds_;
+    // The links the sweeps take and the root they run under: the scene's, or a local
+    // problem's.
+    Links* active_ = &links_;
+    std::uint32_t activeRoot_ = kNoNode;
     std::int64_t rayCount_ = 0;  // besides exposure's and refinement's
 };
 
 void SceneSolve::Index() {
-    traversal_.Index(hierarchy_, hierarchy_.Root(), links_);
+    traversal_.Index(hierarchy_, activeRoot_, *active_);
     const std::size_t size = hierarchy_.Size();
     // Gathering rewrites only nodes with links: a node whose links refinement moved to
     // its children must hand down nothing.
@@ -215,15 +236,10 @@ void SceneSolve::OnSplit(std::uint32_t n) {
 }
 
 void SceneSolve::Solve(Solution& solution) {
+    activeRoot_ = hierarchy_.Root();
     Index();
     exposure_ = Exposure(model_, rays_, options_.exposureRays);
     const auto& preOrder = traversal_.PreOrder();
-    const auto emitFromRest = [&] {
-        for (std::uint32_t n : preOrder) {
-            field_.radiosity.ClearRow(n);
-            std::copy_n(leafLight_.emission[n], channels_.Count(), field_.radiosity(n, kUpper));
-        }
-    };
     for (std::uint32_t n : preOrder)
         std::copy_n(leafLight_.emission[n], channels_.Count(), field_.radiosity(n, kUpper));
     // The power the sources bring in, unoccluded: the scale of every link's error.
@@ -238,9 +254,8 @@ void SceneSolve::Solve(Solution& solution) {
     }
     if (totalPower <= 0.0) return Outputs(solution);
 
-    const Thresholds thresholds{options_.epsilon * totalPower, options_.clusterTolerance,
-                                sources_.size()};
-    refiner_.emplace(model_, field_, links_, estimator_, visibility_, sources_, thresholds,
+    thresholds_ = {options_.epsilon * totalPower, options_.clusterTolerance, sources_.size()};
+    refiner_.emplace(model_, field_, links_, estimator_, visibility_, sources_, thresholds_,
                      [this](std::uint32_t n) { OnSplit(n); });
     Refiner& refiner = *refiner_;
     Stopwatch clock;
@@ -249,15 +264,10 @@ void SceneSolve::Solve(Solution& solution) {
         sourceTasks.push_back({Task::kSource, hierarchy_.Root(), s});
     }
     refiner.Refine(std::move(sourceTasks));
-    // Direct light first, so that links are refined on what senders will send; with
-    // direct light only, lamps are the only senders and their links the only ones needed.
+    // With direct light only, lamps are the only senders and their links the only ones
+    // needed.
     Index();
-    pushPull_.PushSources(links_, sources_, sourceLight_, Closed());
-    if (!options_.directOnly) {
-        pushPull_.PushDown<false>(links_, gathered_, sourceLight_, leafLight_, Closed());
-        Update();
-    }
-    pushPull_.PullUp(field_);
+    LightFromSources();
     const double sourceSeconds = clock.Lap();
     const std::int64_t sourceRays = rays();
     const bool lamps = std::any_of(preOrder.begin(), preOrder.end(), [&](std::uint32_t n) {
@@ -270,10 +280,28 @@ void SceneSolve::Solve(Solution& solution) {
     const double refineSeconds = clock.Lap();
     const std::int64_t refineRays = rays() - sourceRays;
 
+    Iterate(refiner, solution, clock);
+    if (options_.auditLinks) {
+        solution.linkAudit = AuditLinks(model_, rays_, traversal_.Leaves(), field_, links_,
+                                        sourceLight_, leafLight_, [this] { Collect<false>(); });
+    }
+    const std::int64_t passRays = rays() - sourceRays - refineRays;
+    Outputs(solution);
+    spdlog::debug(
+        "hrc: source links {:.3f} s ({} rays), refinement {:.3f} s ({} rays, {} more in the "
+        "passes), outputs {:.3f} s ({} rays)",
+        sourceSeconds, sourceRays, refineSeconds, refineRays, passRays, clock.Lap(),
+        rays() - sourceRays - refineRays - passRays);
+}
+
+void SceneSolve::Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock) {
     // Jacobi from the emission: the first sweep's light is the direct light. Then the links
     // are judged again with the light of the solution and the iteration goes on from it,
     // until no link needs refining (a pass or two).
-    emitFromRest();
+    for (std::uint32_t n : traversal_.PreOrder()) {
+        field_.radiosity.ClearRow(n);
+        std::copy_n(leafLight_.emission[n], channels_.Count(), field_.radiosity(n, kUpper));
+    }
     pushPull_.PullUp(field_);
     double residual = 0.0;
     int iteration = 0;
@@ -325,24 +353,74 @@ void SceneSolve::Solve(Solution& solution) {
     }
     solution.stats.iterations = std::min(iteration + 1, iterations);
     solution.stats.residual = convergence.Remaining(residual);
-    if (options_.auditLinks) {
-        solution.linkAudit = AuditLinks(model_, rays_, traversal_.Leaves(), field_, links_,
-                                        sourceLight_, leafLight_, [this] { Collect<false>(); });
-    }
-    const std::int64_t passRays = rays() - sourceRays - refineRays;
-    Outputs(solution);
-    spdlog::debug(
-        "hrc: source links {:.3f} s ({} rays), refinement {:.3f} s ({} rays, {} more in the "
-        "passes), outputs {:.3f} s ({} rays)",
-        sourceSeconds, sourceRays, refineSeconds, refineRays, passRays, clock.Lap(),
-        rays() - sourceRays - refineRays - passRays);
+}
+
+Solution SceneSolve::RunLocal(NodeId root) {
+    const std::uint32_t b = hierarchy_.NodeOf(root);
+    LEAFLUX_CHECK(b != kNoNode && refiner_ && hierarchy_.Closed().empty());
+    const ResourceClock clock;
+    Solution solution;
+    solution.light.assign(flat_.receivers.size(), std::vector<BandLight>(channels_.bands));
+    solution.balance.assign(channels_.bands, EnergyBalance{});
+    const int threads = options_.threads > 0 ? options_.threads : tbb::info::default_concurrency();
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+        // The light from outside, held fixed: the links from senders outside the subtree
+        // into it (their senders never split nor updated), the source links into it, and
+        // what b's ancestors hand down.
+        std::vector<std::uint32_t> subtree, stack = {b};
+        while (!stack.empty()) {
+            const std::uint32_t n = stack.back();
+            stack.pop_back();
+            subtree.push_back(n);
+            const auto& children = hierarchy_[n].children;
+            stack.insert(stack.end(), children.begin(), children.end());
+        }
+        std::vector<std::uint8_t> inside(hierarchy_.Size(), 0);
+        for (std::uint32_t n : subtree) inside[n] = 1;
+        Links local;
+        local.Resize(hierarchy_.Size());
+        for (std::uint32_t n : subtree) {
+            for (const NodeLink& link : links_.node[n]) {
+                if (!inside[link.sender]) local.node[n].push_back(link);
+            }
+            local.source[n] = links_.source[n];
+        }
+        pushPull_.HoldAbove(pushPull_.BinsAbove(b, links_, gathered_),
+                            pushPull_.SourcesAbove(b, links_, sources_.size()));
+        active_ = &local;
+        activeRoot_ = b;
+        Refiner refiner(model_, field_, local, estimator_, visibility_, sources_, thresholds_,
+                        [this](std::uint32_t n) { OnSplit(n); });
+        refiner.HoldFixedOutside(b);
+        Stopwatch watch;
+        // The subtree from its emission, then as a scene of its own: direct light, its own
+        // exchanges refined, refine–solve passes.
+        Index();
+        for (std::uint32_t n : subtree) {
+            field_.radiosity.ClearRow(n);
+            std::copy_n(leafLight_.emission[n], channels_.Count(), field_.radiosity(n, kUpper));
+        }
+        pushPull_.PullUp(field_);
+        LightFromSources();
+        if (!options_.directOnly) refiner.Refine({{Task::kSelf, b, b}});
+        Index();
+        Iterate(refiner, solution, watch);
+        Outputs(solution);
+        active_ = &links_;
+        activeRoot_ = hierarchy_.Root();
+        pushPull_.HoldAbove({}, {});
+    });
+    clock.Stamp(solution.stats);
+    solution.stats.threads = threads;
+    return solution;
 }
 
 void SceneSolve::Outputs(Solution& solution) {
-    solution.stats.links = static_cast<std::int64_t>(links_.Count());
+    solution.stats.links = static_cast<std::int64_t>(active_->Count());
     solution.stats.elements = static_cast<std::int64_t>(hierarchy_.Size());
-    solution.stats.refinementDepth =
-        static_cast<int>(traversal_.Subtrees().empty() ? 0 : traversal_.Depth(hierarchy_, links_));
+    solution.stats.refinementDepth = static_cast<int>(
+        traversal_.Subtrees().empty() ? 0 : traversal_.Depth(hierarchy_, *active_));
     rayCount_ +=
         WriteOutputs(model_, rays_, traversal_.Leaves(), optics_, field_, leafLight_, solution);
 }
@@ -358,6 +436,18 @@ Solution SolveHrc(const Scene& scene, const FlatScene& flat, const RayScene& ray
     SceneSolve solver(scene, flat, rays, options, closed);
     spdlog::debug("hrc: hierarchy built in {:.3f} s", watch.Lap());
     return solver.Run(clock);
+}
+
+LocalSolve SolveHrcThenLocal(const Scene& scene, const FlatScene& flat, const RayScene& rays,
+                             const HrcOptions& options, NodeId root) {
+    LEAFLUX_CHECK(options.directionLevel >= 0 && options.directionLevel <= 4);
+    LEAFLUX_CHECK(!scene.bands.empty());
+    const ResourceClock clock;
+    SceneSolve solver(scene, flat, rays, options, {});
+    LocalSolve result;
+    result.whole = solver.Run(clock);
+    result.local = solver.RunLocal(root);
+    return result;
 }
 
 }  // namespace leaflux

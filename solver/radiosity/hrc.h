@@ -95,4 +95,17 @@ struct HrcOptions {
 Solution SolveHrc(const Scene& scene, const FlatScene& flat, const RayScene& rays,
                   const HrcOptions& options, std::span<const ClosedNode> closed = {});
 
+// The scene solved whole, then the structure under scene node `root` solved again alone as
+// a local problem (Soler 2003 §3.3–3.4): everything outside it held fixed — the links that
+// reach into it from outside, copied with their senders never split nor updated, the
+// directional sources' links into it, and the light its ancestors hand down — its own
+// exchanges refined again from its own emission under the whole solve's threshold. `local`
+// has the structure's receivers' light (the others' are zero); its balance is the
+// structure's.
+struct LocalSolve {
+    Solution whole, local;
+};
+LocalSolve SolveHrcThenLocal(const Scene& scene, const FlatScene& flat, const RayScene& rays,
+                             const HrcOptions& options, NodeId root);
+
 }  // namespace leaflux

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "solver/util/check.h"
+
 namespace leaflux {
 namespace {
 constexpr double kPi = glm::pi<double>();
@@ -81,14 +83,17 @@ void PushPull::PullNode(Field& field, std::uint32_t n) const {
 }
 
 template <class Holds, class Add, class Top>
-void PushPull::DescendAll(std::size_t width, Holds holds, Add add, Top top) const {
+void PushPull::DescendAll(std::size_t width, Holds holds, Add add, Top top,
+                          const std::vector<double>& fixed) const {
     const auto& preOrder = traversal_.PreOrder();
     const auto& subtrees = traversal_.Subtrees();
+    const std::uint32_t root = traversal_.Root();
     tbb::parallel_for(std::size_t{0}, subtrees.size(), [&](std::size_t t) {
         const std::uint32_t start = preOrder[subtrees[t].first];
-        std::vector<double> above(width, 0.0);
+        std::vector<double> above = fixed.empty() ? std::vector<double>(width, 0.0) : fixed;
         std::vector<std::uint32_t> chain;  // handed down from the root, as Descend does
-        for (std::uint32_t m = hierarchy_[start].parent; m != kNoNode; m = hierarchy_[m].parent) {
+        for (std::uint32_t m = start; m != root;) {
+            m = hierarchy_[m].parent;
             if (holds(m)) chain.push_back(m);
         }
         for (auto m = chain.rbegin(); m != chain.rend(); ++m) add(*m, above);
@@ -155,7 +160,7 @@ void PushPull::PushSources(const Links& links, const std::vector<DirectionalSour
     out.moment.Assign(size);
     const auto holds = [&](std::uint32_t n) { return !links.source[n].empty(); };
     const auto add = [&](std::uint32_t n, std::vector<double>& visibility) {
-        for (const SourceLink& link : links.source[n]) visibility[link.source] += link.visibility;
+        AddSources(n, links, visibility);
     };
     const auto leaf = [&](std::uint32_t n, const std::vector<double>& visibility) {
         const HrcNode& node = hierarchy_[n];
@@ -182,7 +187,7 @@ void PushPull::PushSources(const Links& links, const std::vector<DirectionalSour
         }
         DescendPatches(t, visibility, scratch.levels, 0, holds, add, leaf);
     };
-    DescendAll(sources.size(), holds, add, top);
+    DescendAll(sources.size(), holds, add, top, aboveSources_);
 }
 
 // An arrival on a patch, as PushDown hands it down: per channel, W/m² on the upper and
@@ -214,21 +219,9 @@ void PushPull::PushDown(const Links& links, const Gathered& gathered, const Sour
     const int bins = model_.BinCount();
     const int channels = model_.ChannelSet().Count();
     const DirectionSet& directions = model_.Directions();
-    const auto gathers = [&](std::uint32_t n) {
-        return !model_.Planar(n) && !links.node[n].empty();
-    };
-    const auto holds = [&](std::uint32_t n) { return gathers(n) || exposure_.Exposed(n); };
+    const auto holds = [&](std::uint32_t n) { return HoldsBins(n, links); };
     const auto add = [&](std::uint32_t n, std::vector<double>& sum) {
-        if (exposure_.Exposed(n)) {
-            const float* share = exposure_.Share(n);
-            for (int d = 0; d < bins; ++d) {
-                for (int k = 0; k < channels; ++k)
-                    sum[d * channels + k] *= static_cast<double>(share[d]);
-            }
-        }
-        if (!gathers(n)) return;
-        const double* in = gathered.bins[model_.Slot(n)];
-        for (int i = 0; i < bins * channels; ++i) sum[i] += in[i];
+        AddBins(n, links, gathered, sum);
     };
     const auto patchHolds = [&](std::uint32_t n) { return !links.node[n].empty(); };
     const auto addGathered = [&](std::uint32_t n, std::vector<double>& value) {
@@ -289,7 +282,54 @@ void PushPull::PushDown(const Links& links, const Gathered& gathered, const Sour
             addGathered(m, scratch.top);
         DescendPatches(t, scratch.top, scratch.levels, 0, patchHolds, addGathered, leaf);
     };
-    DescendAll(static_cast<std::size_t>(bins) * channels, holds, add, top);
+    DescendAll(static_cast<std::size_t>(bins) * channels, holds, add, top, aboveBins_);
+}
+
+bool PushPull::HoldsBins(std::uint32_t n, const Links& links) const {
+    return (!model_.Planar(n) && !links.node[n].empty()) || exposure_.Exposed(n);
+}
+
+void PushPull::AddBins(std::uint32_t n, const Links& links, const Gathered& gathered,
+                       std::vector<double>& sum) const {
+    const int bins = model_.BinCount(), channels = model_.ChannelSet().Count();
+    if (exposure_.Exposed(n)) {
+        const float* share = exposure_.Share(n);
+        for (int d = 0; d < bins; ++d) {
+            for (int k = 0; k < channels; ++k)
+                sum[d * channels + k] *= static_cast<double>(share[d]);
+        }
+    }
+    if (model_.Planar(n) || links.node[n].empty()) return;
+    const double* in = gathered.bins[model_.Slot(n)];
+    for (int i = 0; i < bins * channels; ++i) sum[i] += in[i];
+}
+
+void PushPull::AddSources(std::uint32_t n, const Links& links,
+                          std::vector<double>& visibility) const {
+    for (const SourceLink& link : links.source[n]) visibility[link.source] += link.visibility;
+}
+
+std::vector<double> PushPull::BinsAbove(std::uint32_t n, const Links& links,
+                                        const Gathered& gathered) const {
+    std::vector<std::uint32_t> chain;
+    for (std::uint32_t m = hierarchy_[n].parent; m != kNoNode; m = hierarchy_[m].parent) {
+        LEAFLUX_CHECK(!model_.Planar(m));  // a plane's parts share its light: no subtree there
+        if (HoldsBins(m, links)) chain.push_back(m);
+    }
+    std::vector<double> sum(
+        static_cast<std::size_t>(model_.BinCount()) * model_.ChannelSet().Count(), 0.0);
+    for (auto m = chain.rbegin(); m != chain.rend(); ++m) AddBins(*m, links, gathered, sum);
+    return sum;
+}
+
+std::vector<double> PushPull::SourcesAbove(std::uint32_t n, const Links& links,
+                                           std::size_t sourceCount) const {
+    std::vector<std::uint32_t> chain;  // added from the top down, as DescendAll adds them
+    for (std::uint32_t m = hierarchy_[n].parent; m != kNoNode; m = hierarchy_[m].parent)
+        chain.push_back(m);
+    std::vector<double> visibility(sourceCount, 0.0);
+    for (auto m = chain.rbegin(); m != chain.rend(); ++m) AddSources(*m, links, visibility);
+    return visibility;
 }
 
 template void PushPull::PushDown<false>(const Links&, const Gathered&, const SourceLight&,

@@ -22,6 +22,19 @@ class PushPull {
     PushPull(const NodeModel& model, const Traversal& traversal, const Exposure& exposure)
         : hierarchy_(model.Nodes()), model_(model), traversal_(traversal), exposure_(exposure) {}
 
+    // A local problem (a subtree solved alone): the light its ancestors hand down to its
+    // root, held fixed — per bin and channel, and the visibility of each source (BinsAbove,
+    // SourcesAbove of the problem it came from). Empty: none.
+    void HoldAbove(std::vector<double> bins, std::vector<double> sources) {
+        aboveBins_ = std::move(bins);
+        aboveSources_ = std::move(sources);
+    }
+    // What node n's ancestors hand down to it.
+    std::vector<double> BinsAbove(std::uint32_t n, const Links& links,
+                                  const Gathered& gathered) const;
+    std::vector<double> SourcesAbove(std::uint32_t n, const Links& links,
+                                     std::size_t sourceCount) const;
+
     // Children before parents: every node's emitted power, every plane's mean radiosity and
     // every cluster's intensity per direction from the leaf patches' radiosity.
     void PullUp(Field& field) const;
@@ -46,6 +59,11 @@ class PushPull {
         std::deque<std::vector<double>> levels;
     };
     void PullNode(Field& field, std::uint32_t n) const;
+    // Whether node n holds cluster light to hand down, and adding it to a sum of bins.
+    bool HoldsBins(std::uint32_t n, const Links& links) const;
+    void AddBins(std::uint32_t n, const Links& links, const Gathered& gathered,
+                 std::vector<double>& sum) const;
+    void AddSources(std::uint32_t n, const Links& links, std::vector<double>& visibility) const;
     // Handing light down to the leaf patches. Descend visits the top patches under `start`
     // (the first patch on each way down, or `start` itself) and the closed instances with
     // the sum of what their
@@ -57,9 +75,11 @@ class PushPull {
     void Descend(std::uint32_t start, const std::vector<double>& above, Holds holds, Add add,
                  Top top, Scratch& scratch) const;
     // Descend over every subtree of the traversal in parallel, each from the sum of what
-    // the nodes above it hold (sums of `width` numbers).
+    // the nodes above it up to the traversal's root hold (sums of `width` numbers), on top
+    // of `fixed` (what is held above the root) when it is not empty.
     template <class Holds, class Add, class Top>
-    void DescendAll(std::size_t width, Holds holds, Add add, Top top) const;
+    void DescendAll(std::size_t width, Holds holds, Add add, Top top,
+                    const std::vector<double>& fixed) const;
     // Visits the leaf patches under patch t with `value` plus, for every patch m strictly
     // below t on the way with holds(m), what add(m, value) adds; levels[level] and deeper
     // are free for the sums.
@@ -72,6 +92,7 @@ class PushPull {
     const NodeModel& model_;
     const Traversal& traversal_;
     const Exposure& exposure_;
+    std::vector<double> aboveBins_, aboveSources_;
 };
 
 }  // namespace leaflux

@@ -107,13 +107,12 @@ Refiner::Verdict Refiner::JudgeSource(std::uint32_t r, std::uint32_t s) const {
     // The spread is least when every ray agrees: beyond ε even then, no ray can save
     // the link, and none is traced.
     const double threshold = SourceThreshold(r);
-    if (unoccluded * VisibilitySpread(1.0, visibility_.SourceRays()) > threshold &&
-        model_.CanSplit(r))
+    if (unoccluded * VisibilitySpread(1.0, visibility_.SourceRays()) > threshold && CanSplit(r))
         return {Verdict::kSplitReceiver, {}, 0.0f, 0};
     Verdict verdict;
     const double v = visibility_.FromSource(r, s, source.toward, verdict.rays);
     const double error = unoccluded * VisibilitySpread(v, visibility_.SourceRays());
-    if (error > threshold && model_.CanSplit(r)) {
+    if (error > threshold && CanSplit(r)) {
         verdict.kind = Verdict::kSplitReceiver;
     } else if (v > 0.0) {
         verdict.kind = Verdict::kLink;
@@ -131,8 +130,8 @@ Refiner::Verdict::Kind Refiner::SplitChoice(std::uint32_t r, std::uint32_t s) co
     const bool receiverLarger = hierarchy_[r].radius >= hierarchy_[s].radius;
     const auto larger = receiverLarger ? Verdict::kSplitReceiver : Verdict::kSplitSender;
     const auto smaller = receiverLarger ? Verdict::kSplitSender : Verdict::kSplitReceiver;
-    if (model_.CanSplit(receiverLarger ? r : s)) return larger;
-    if (model_.CanSplit(receiverLarger ? s : r)) return smaller;
+    if (CanSplit(receiverLarger ? r : s)) return larger;
+    if (CanSplit(receiverLarger ? s : r)) return smaller;
     return Verdict::kNone;
 }
 

@@ -85,6 +85,10 @@ class Refiner {
 
     std::int64_t Rays() const { return rays_; }
 
+    // A local problem: only the nodes under `root` may be split; every other node is a
+    // fixed sender, its light held as it is.
+    void HoldFixedOutside(std::uint32_t root) { localRoot_ = root; }
+
   private:
     struct Verdict {
         enum Kind : std::uint8_t { kNone, kLink, kSplitReceiver, kSplitSender };
@@ -98,6 +102,16 @@ class Refiner {
     void Carry(const Task& task, const Verdict& verdict, std::vector<Task>& stack);
     Verdict JudgeSource(std::uint32_t r, std::uint32_t s) const;
     Verdict JudgePair(std::uint32_t r, std::uint32_t s) const;
+    // Whether node n may be split here: it can be, and it is not held fixed.
+    bool CanSplit(std::uint32_t n) const {
+        return model_.CanSplit(n) && (localRoot_ == kNoNode || Within(n));
+    }
+    bool Within(std::uint32_t n) const {
+        for (; n != kNoNode; n = hierarchy_[n].parent) {
+            if (n == localRoot_) return true;
+        }
+        return false;
+    }
     // Which of r and s a link between them splits: the larger, or the other when the
     // larger cannot be split; none when neither can.
     Verdict::Kind SplitChoice(std::uint32_t r, std::uint32_t s) const;
@@ -120,6 +134,7 @@ class Refiner {
     const Thresholds thresholds_;
     SplitHook onSplit_;
     std::int64_t rays_ = 0;
+    std::uint32_t localRoot_ = kNoNode;
 };
 
 }  // namespace leaflux

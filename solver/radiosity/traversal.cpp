@@ -6,6 +6,7 @@
 namespace leaflux {
 
 void Traversal::Index(const Hierarchy& hierarchy, std::uint32_t root, const Links& links) {
+    root_ = root;
     preOrder_.clear();
     std::vector<std::uint32_t> stack = {root};
     while (!stack.empty()) {

@@ -18,6 +18,7 @@ class Traversal {
     // Indexes the hierarchy under `root` as it stands, with the links it holds.
     void Index(const Hierarchy& hierarchy, std::uint32_t root, const Links& links);
 
+    std::uint32_t Root() const { return root_; }
     const std::vector<std::uint32_t>& PreOrder() const { return preOrder_; }
     const std::vector<std::uint32_t>& Leaves() const { return leaves_; }        // leaf patches
     const std::vector<std::uint32_t>& Receivers() const { return receivers_; }  // with links
@@ -30,6 +31,7 @@ class Traversal {
   private:
     void Share(const Hierarchy& hierarchy);
 
+    std::uint32_t root_ = kNoNode;
     std::vector<std::uint32_t> preOrder_, leaves_, receivers_, above_;
     std::vector<std::pair<std::size_t, std::size_t>> subtrees_;
 };
