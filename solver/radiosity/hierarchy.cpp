@@ -320,6 +320,16 @@ bool Hierarchy::Subdivide(std::uint32_t index, double minAreaM2) {
     return true;
 }
 
+void Hierarchy::Truncate(std::size_t size) {
+    LEAFLUX_CHECK(size <= nodes_.size());
+    for (std::size_t n = size; n < nodes_.size(); ++n) {
+        const std::uint32_t parent = nodes_[n].parent;
+        LEAFLUX_CHECK(nodes_[n].patch && parent != kNoNode);
+        if (parent < size) nodes_[parent].children.clear();
+    }
+    nodes_.resize(size);
+}
+
 Hierarchy::Point Hierarchy::SampleClosed(std::int32_t closed, double u, double v) const {
     // A point of the box from two numbers: the third coordinate from the digits of the first
     // two that their own coordinates do not resolve.

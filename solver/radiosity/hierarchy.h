@@ -71,6 +71,10 @@ class Hierarchy {
         return it == ofScene_.end() ? kNoNode : it->second;
     }
 
+    // Releases the nodes made since the hierarchy had `size` (patches a local problem split):
+    // the patches they were split from are whole again.
+    void Truncate(std::size_t size);
+
     // A point on the node's surfaces, area-weighted, from two uniform numbers; with the
     // flat triangle it lies on (for rays to leave it). A point of a closed instance lies in
     // its box, of no triangle and no normal (it takes and sends light in every direction).

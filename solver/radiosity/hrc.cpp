@@ -390,6 +390,7 @@ Solution SceneSolve::RunLocal(NodeId root) {
                             pushPull_.SourcesAbove(b, links_, sources_.size()));
         active_ = &local;
         activeRoot_ = b;
+        const std::size_t size = hierarchy_.Size();
         Refiner refiner(model_, field_, local, estimator_, visibility_, sources_, thresholds_,
                         [this](std::uint32_t n) { OnSplit(n); });
         refiner.HoldFixedOutside(b);
@@ -407,9 +408,14 @@ Solution SceneSolve::RunLocal(NodeId root) {
         Index();
         Iterate(refiner, solution, watch);
         Outputs(solution);
+        // The local hierarchy released: the patches it split are whole again.
         active_ = &links_;
         activeRoot_ = hierarchy_.Root();
         pushPull_.HoldAbove({}, {});
+        model_.Truncate(size);
+        field_.Resize(size);
+        links_.Resize(size);
+        Index();
     });
     clock.Stamp(solution.stats);
     solution.stats.threads = threads;
@@ -421,8 +427,9 @@ void SceneSolve::Outputs(Solution& solution) {
     solution.stats.elements = static_cast<std::int64_t>(hierarchy_.Size());
     solution.stats.refinementDepth = static_cast<int>(
         traversal_.Subtrees().empty() ? 0 : traversal_.Depth(hierarchy_, *active_));
-    rayCount_ +=
-        WriteOutputs(model_, rays_, traversal_.Leaves(), optics_, field_, leafLight_, solution);
+    SolutionSink sink(solution);
+    rayCount_ += WriteOutputs(model_, rays_, traversal_.Leaves(), optics_, field_, leafLight_, sink,
+                              solution.balance);
 }
 
 }  // namespace

@@ -98,6 +98,11 @@ class NodeModel {
     double MinArea(const HrcNode& patch) const;
     // Splits patch n into four (CanSplit holds); the new nodes are at the hierarchy's end.
     void Subdivide(std::uint32_t n);
+    // Releases the nodes made since the hierarchy had `size` (Hierarchy::Truncate).
+    void Truncate(std::size_t size) {
+        hierarchy_.Truncate(size);
+        slot_.resize(size);
+    }
 
     // A plane's parts, whose form factors and solid angles add up to its own: a patch
     // itself, a flat cluster its children.

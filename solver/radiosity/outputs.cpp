@@ -13,9 +13,9 @@ namespace leaflux {
 
 std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
                           const std::vector<std::uint32_t>& leaves, const ReceiverOptics& optics,
-                          const Field& field, const LeafLight& leafLight, Solution& solution) {
+                          const Field& field, const LeafLight& leafLight, LightSink& sink,
+                          std::vector<EnergyBalance>& balances) {
     const Hierarchy& hierarchy = model.Nodes();
-    const FlatScene& flat = hierarchy.Flat();
     const int bands = model.ChannelSet().Count();
     LEAFLUX_CHECK(model.ChannelSet().beams == 1);
     std::int64_t traced = 0;
@@ -65,29 +65,50 @@ std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
         }
     });
     for (std::int64_t r : traces) traced += r;
-    std::vector<double> area(flat.receivers.size(), 0.0);
+    // A receiver's leaf patches lie together in the hierarchy's order (under its organ's or
+    // surface's node): its light is handed to the sink once the last is reached.
     std::vector<double> variance(bands, 0.0);
+    std::vector<BandLight> light(bands);
+    std::uint32_t receiver = kNoNode;
+    double area = 0.0;
+    const auto emit = [&] {
+        if (receiver == kNoNode) return;
+        for (BandLight& band : light) {
+            if (area <= 0.0) continue;
+            band.irradianceUpperWm2 /= area;
+            band.irradianceLowerWm2 /= area;
+            band.radianceIntegral /= area;
+            band.radianceMoment /= area;
+        }
+        sink.Receiver(receiver, light);
+    };
     for (std::size_t i = 0; i < leaves.size(); ++i) {
         const std::uint32_t n = leaves[i];
         const HrcNode& node = hierarchy[n];
         const double a = node.areaM2;
-        area[node.receiver] += a;
+        if (node.receiver != receiver) {
+            emit();
+            receiver = node.receiver;
+            light.assign(bands, BandLight{});
+            area = 0.0;
+        }
+        area += a;
         for (int k = 0; k < bands; ++k) {
-            BandLight& light = solution.light[node.receiver][k];
+            BandLight& band = light[k];
             const double eUpper = leafLight.irradiance(n, kUpper)[k];
             const double eLower = leafLight.irradiance(n, kLower)[k];
-            light.irradianceUpperWm2 += a * eUpper;
-            light.irradianceLowerWm2 += a * eLower;
+            band.irradianceUpperWm2 += a * eUpper;
+            band.irradianceLowerWm2 += a * eLower;
             const double absorbed = a * ((1.0 - optics.rho(node.receiver, kUpper)[k] -
                                           optics.tau(node.receiver, kUpper)[k]) *
                                              eUpper +
                                          (1.0 - optics.rho(node.receiver, kLower)[k] -
                                           optics.tau(node.receiver, kLower)[k]) *
                                              eLower);
-            light.absorbedW += absorbed;
-            light.radianceIntegral += a * leafLight.integral[n][k];
-            light.radianceMoment += a * leafLight.moment[n][k];
-            EnergyBalance& balance = solution.balance[k];
+            band.absorbedW += absorbed;
+            band.radianceIntegral += a * leafLight.integral[n][k];
+            band.radianceMoment += a * leafLight.moment[n][k];
+            EnergyBalance& balance = balances[k];
             balance.incidentW +=
                 a * (leafLight.direct(n, kUpper)[k] + leafLight.direct(n, kLower)[k]);
             balance.absorbedW += absorbed;
@@ -97,17 +118,9 @@ std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
             variance[k] += upper * upper * doubt[i][kUpper] + lower * lower * doubt[i][kLower];
         }
     }
+    emit();
     // The links' own error is not in it: this is the escape estimate's noise alone.
-    for (int k = 0; k < bands; ++k) solution.balance[k].stderrW = std::sqrt(variance[k]);
-    for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
-        for (BandLight& light : solution.light[r]) {
-            if (area[r] <= 0.0) continue;
-            light.irradianceUpperWm2 /= area[r];
-            light.irradianceLowerWm2 /= area[r];
-            light.radianceIntegral /= area[r];
-            light.radianceMoment /= area[r];
-        }
-    }
+    for (int k = 0; k < bands; ++k) balances[k].stderrW = std::sqrt(variance[k]);
     return traced;
 }
 

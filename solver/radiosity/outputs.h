@@ -15,10 +15,33 @@
 
 namespace leaflux {
 
-// Fills solution.light and solution.balance (sized by the caller) from the leaf patches
-// `leaves`; returns the rays it traced. A scene's solve: one channel per band.
+// Where a solve's light goes as its receivers are reached, so that a local problem hands on
+// its organs' light without holding the scene's.
+class LightSink {
+  public:
+    virtual ~LightSink() = default;
+    // Receiver `receiver` (a FlatScene index), per band, once all its leaf patches are in.
+    virtual void Receiver(std::size_t receiver, const std::vector<BandLight>& light) = 0;
+};
+
+// Into a Solution's light, sized by its owner.
+class SolutionSink : public LightSink {
+  public:
+    explicit SolutionSink(Solution& solution) : solution_(solution) {}
+    void Receiver(std::size_t receiver, const std::vector<BandLight>& light) override {
+        solution_.light[receiver] = light;
+    }
+
+  private:
+    Solution& solution_;
+};
+
+// Hands each receiver of the leaf patches `leaves` to the sink and adds their energy
+// balance to `balances` (one per band); returns the rays it traced. A scene's solve: one
+// channel per band.
 std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
                           const std::vector<std::uint32_t>& leaves, const ReceiverOptics& optics,
-                          const Field& field, const LeafLight& leafLight, Solution& solution);
+                          const Field& field, const LeafLight& leafLight, LightSink& sink,
+                          std::vector<EnergyBalance>& balances);
 
 }  // namespace leaflux
