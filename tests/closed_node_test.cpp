@@ -52,11 +52,16 @@ ClosedNode UnitBoxAtOrigin(const FlatScene& flat) {
     return node;
 }
 
-HrcOptions Options(bool directOnly) {
+// The plates lit beside the scatterer, by HRC at ε = 1e-5.
+Solution SolveWithScatterer(bool directOnly) {
+    const Scene scene = PlatesBesideAndBelow();
+    scene.Validate();
+    const PreparedScene prepared(scene);
+    const ClosedNode closed = UnitBoxAtOrigin(prepared.Flat());
     HrcOptions options;
     options.epsilon = 1e-5;
     options.directOnly = directOnly;
-    return options;
+    return SolveHrc(scene, prepared.Flat(), prepared.Rays(), options, {&closed, 1});
 }
 
 // The irradiance a uniform isotropic volume emitter of intensity I (the unit cube at the
@@ -83,12 +88,7 @@ double BesidePlateReference(double intensity) {
 }
 
 TEST(ClosedNode, AnIsotropicScattererLightsAReceiverBesideItAsItsClosedForm) {
-    const Scene scene = PlatesBesideAndBelow();
-    scene.Validate();
-    const PreparedScene prepared(scene);
-    const ClosedNode closed = UnitBoxAtOrigin(prepared.Flat());
-    const Solution s =
-        SolveHrc(scene, prepared.Flat(), prepared.Rays(), Options(false), {&closed, 1});
+    const Solution s = SolveWithScatterer(false);
     const double intensity = kAlbedo * kSun * 1.0 * (1.0 - kTau) / (4.0 * kPi);
     const double expected = BesidePlateReference(intensity);
     // The link carries the box's light as a point transfer with its spread's second-order
@@ -101,12 +101,7 @@ TEST(ClosedNode, AnIsotropicScattererLightsAReceiverBesideItAsItsClosedForm) {
 }
 
 TEST(ClosedNode, RaysThroughItAreAttenuatedByExactlyItsTransmittance) {
-    const Scene scene = PlatesBesideAndBelow();
-    scene.Validate();
-    const PreparedScene prepared(scene);
-    const ClosedNode closed = UnitBoxAtOrigin(prepared.Flat());
-    const Solution s =
-        SolveHrc(scene, prepared.Flat(), prepared.Rays(), Options(true), {&closed, 1});
+    const Solution s = SolveWithScatterer(true);
     // Exactly but for the single precision a source link keeps its visibility in.
     EXPECT_NEAR(s.light[1][0].irradianceUpperWm2, kTau * kSun, 0x1p-24 * kSun);
     EXPECT_NEAR(s.light[0][0].irradianceUpperWm2, 0.0, 1e-9);  // the sun grazes it

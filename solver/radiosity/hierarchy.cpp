@@ -320,6 +320,18 @@ bool Hierarchy::Subdivide(std::uint32_t index, double minAreaM2) {
     return true;
 }
 
+std::vector<std::uint32_t> Hierarchy::PreOrder(std::uint32_t root) const {
+    std::vector<std::uint32_t> order, stack = {root};
+    while (!stack.empty()) {
+        const std::uint32_t n = stack.back();
+        stack.pop_back();
+        order.push_back(n);
+        const auto& children = nodes_[n].children;
+        for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);
+    }
+    return order;
+}
+
 void Hierarchy::Truncate(std::size_t size) {
     LEAFLUX_CHECK(size <= nodes_.size());
     for (std::size_t n = size; n < nodes_.size(); ++n) {

@@ -71,6 +71,9 @@ class Hierarchy {
         return it == ofScene_.end() ? kNoNode : it->second;
     }
 
+    // The nodes under `root`, parents before children, children in their order.
+    std::vector<std::uint32_t> PreOrder(std::uint32_t root) const;
+
     // Releases the nodes made since the hierarchy had `size` (patches a local problem split):
     // the patches they were split from are whole again.
     void Truncate(std::size_t size);

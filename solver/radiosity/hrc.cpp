@@ -368,14 +368,7 @@ Solution SceneSolve::RunLocal(NodeId root) {
         // The light from outside, held fixed: the links from senders outside the subtree
         // into it (their senders never split nor updated), the source links into it, and
         // what b's ancestors hand down.
-        std::vector<std::uint32_t> subtree, stack = {b};
-        while (!stack.empty()) {
-            const std::uint32_t n = stack.back();
-            stack.pop_back();
-            subtree.push_back(n);
-            const auto& children = hierarchy_[n].children;
-            stack.insert(stack.end(), children.begin(), children.end());
-        }
+        const std::vector<std::uint32_t> subtree = hierarchy_.PreOrder(b);
         std::vector<std::uint8_t> inside(hierarchy_.Size(), 0);
         for (std::uint32_t n : subtree) inside[n] = 1;
         Links local;

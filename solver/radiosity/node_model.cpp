@@ -117,14 +117,7 @@ void NodeModel::ScaleLobes() {
 void NodeModel::AssignSlots() {
     slot_.assign(hierarchy_.Size(), kNoNode);
     if (hierarchy_.Root() == kNoNode) return;
-    std::vector<std::uint32_t> preOrder, stack = {hierarchy_.Root()};
-    while (!stack.empty()) {
-        const std::uint32_t n = stack.back();
-        stack.pop_back();
-        preOrder.push_back(n);
-        const auto& children = hierarchy_[n].children;
-        for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);
-    }
+    const std::vector<std::uint32_t> preOrder = hierarchy_.PreOrder(hierarchy_.Root());
     for (std::uint32_t n : preOrder) {
         if (!hierarchy_[n].patch) slot_[n] = slots_++;
     }

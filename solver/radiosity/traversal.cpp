@@ -7,15 +7,7 @@ namespace leaflux {
 
 void Traversal::Index(const Hierarchy& hierarchy, std::uint32_t root, const Links& links) {
     root_ = root;
-    preOrder_.clear();
-    std::vector<std::uint32_t> stack = {root};
-    while (!stack.empty()) {
-        const std::uint32_t n = stack.back();
-        stack.pop_back();
-        preOrder_.push_back(n);
-        const auto& children = hierarchy[n].children;
-        for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);
-    }
+    preOrder_ = hierarchy.PreOrder(root);
     leaves_.clear();
     for (std::uint32_t n : preOrder_) {
         if (hierarchy[n].patch && hierarchy[n].children.empty()) leaves_.push_back(n);

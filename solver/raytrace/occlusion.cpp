@@ -128,21 +128,9 @@ double Occlusion::ThroughBoxes(const RayStart& start, const glm::dvec3& directio
     query.direction = direction;
     query.tFar = maxDistance;
     query.exclude = exclude;
-    RTCRay ray;
-    ray.org_x = static_cast<float>(start.origin.x);
-    ray.org_y = static_cast<float>(start.origin.y);
-    ray.org_z = static_cast<float>(start.origin.z);
-    ray.dir_x = static_cast<float>(direction.x);
-    ray.dir_y = static_cast<float>(direction.y);
-    ray.dir_z = static_cast<float>(direction.z);
-    ray.tnear = 0.0f;
+    RTCRay ray = EmbreeRay(start, direction, maxDistance);
     // A little beyond the end in float: the callback clips to the exact segment in double.
-    ray.tfar = std::isinf(maxDistance) ? INFINITY
-                                       : std::nextafter(static_cast<float>(maxDistance), INFINITY);
-    ray.time = 0.0f;
-    ray.mask = 0xFFFFFFFFu;
-    ray.id = 0;
-    ray.flags = 0;
+    if (!std::isinf(maxDistance)) ray.tfar = std::nextafter(ray.tfar, INFINITY);
     rtcOccluded1(scene_, &query.context, &ray);
     return query.transmittance;
 }

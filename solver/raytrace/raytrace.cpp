@@ -63,7 +63,9 @@ StartContext MakeContext(int copy) {
     return context;
 }
 
-RTCRay MakeRay(const RayStart& start, const glm::dvec3& direction, double tFar) {
+}  // namespace
+
+RTCRay EmbreeRay(const RayStart& start, const glm::dvec3& direction, double tFar) {
     RTCRay ray;
     ray.org_x = static_cast<float>(start.origin.x);
     ray.org_y = static_cast<float>(start.origin.y);
@@ -79,6 +81,8 @@ RTCRay MakeRay(const RayStart& start, const glm::dvec3& direction, double tFar) 
     ray.flags = 0;
     return ray;
 }
+
+namespace {
 
 RayFate Escape(const glm::dvec3& direction) {
     return direction.z > 0.0 ? RayFate::kEscapedUp : RayFate::kEscapedDown;
@@ -173,7 +177,7 @@ RayScene::~RayScene() {
 RayHit RayScene::TraceOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const {
     StartContext context = MakeContext(start.copy);
     RTCRayHit rayHit;
-    rayHit.ray = MakeRay(start, direction, tFar);
+    rayHit.ray = EmbreeRay(start, direction, tFar);
     rayHit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rayHit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(top_, &context.context, &rayHit);
@@ -191,7 +195,7 @@ RayHit RayScene::TraceOnce(const RayStart& start, const glm::dvec3& direction, d
 
 bool RayScene::OccludedOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const {
     StartContext context = MakeContext(start.copy);
-    RTCRay ray = MakeRay(start, direction, tFar);
+    RTCRay ray = EmbreeRay(start, direction, tFar);
     rtcOccluded1(top_, &context.context, &ray);
     return ray.tfar < 0.0f;  // Embree sets tfar to -inf on occlusion
 }
@@ -272,7 +276,7 @@ void RayScene::Occluded(const std::vector<RayStart>& starts, const glm::dvec3& d
     thread_local std::vector<RTCRay> rays;
     rays.clear();
     for (const RayStart& start : starts) {
-        rays.push_back(MakeRay(start, direction, std::numeric_limits<double>::infinity()));
+        rays.push_back(EmbreeRay(start, direction, std::numeric_limits<double>::infinity()));
     }
     StartContext context = MakeContext(0);
     context.context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -285,7 +289,7 @@ bool RayScene::OccludedByGroup(const RayStart& start, const glm::dvec3& directio
                                double maxDistance, const Group& group) const {
     StartContext context = MakeContext(start.copy);
     context.group = &group;
-    RTCRay ray = MakeRay(start, direction, maxDistance);
+    RTCRay ray = EmbreeRay(start, direction, maxDistance);
     rtcOccluded1(top_, &context.context, &ray);
     return ray.tfar < 0.0f;
 }

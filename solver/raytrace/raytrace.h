@@ -22,6 +22,11 @@ namespace leaflux {
 // Sets flush-to-zero and denormals-are-zero on the calling thread, as Embree asks.
 void SetFlushToZero();
 
+struct RayStart;
+// Embree's ray from start along direction up to tFar (infinity: unbounded); its id is the
+// start's triangle, which the triangles' filter ignores.
+RTCRay EmbreeRay(const RayStart& start, const glm::dvec3& direction, double tFar);
+
 class RayDevice {
   public:
     RayDevice();
