@@ -127,7 +127,9 @@ double UpdateRadiosity(const Hierarchy& hierarchy, const std::vector<std::uint32
                     dUpper[k] = upper - bUpper[k];
                     dLower[k] = lower - bLower[k];
                     acc.first = std::max({acc.first, std::abs(dUpper[k]), std::abs(dLower[k])});
-                    acc.second = std::max({acc.second, upper, lower});
+                    // Against the light scattered, not emitted: beside a lamp a leaf's change
+                    // is small against the lamp's exitance long before it has settled.
+                    acc.second = std::max({acc.second, upper - emission[k], lower});
                     bUpper[k] = upper;
                     bLower[k] = lower;
                 }
@@ -140,9 +142,27 @@ double UpdateRadiosity(const Hierarchy& hierarchy, const std::vector<std::uint32
     return largest > 0.0 ? change / largest : 0.0;
 }
 
-void Extrapolate(const std::vector<std::uint32_t>& leaves, const LeafLight& leafLight,
-                 double factor, Field& field) {
+double Extrapolate(const std::vector<std::uint32_t>& leaves, const LeafLight& leafLight,
+                   double factor, Field& field) {
     const int channels = field.radiosity.Channels();
+    // The largest factor that leaves every radiosity non-negative: cut at zero, the values
+    // that would go below it would gain light from nowhere.
+    using Range = tbb::blocked_range<std::size_t>;
+    factor = tbb::parallel_reduce(
+        Range(0, leaves.size()), factor,
+        [&](const Range& range, double most) {
+            for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                for (int s : {kUpper, kLower}) {
+                    const double* b = field.radiosity(leaves[i], s);
+                    const double* change = leafLight.change(leaves[i], s);
+                    for (int k = 0; k < channels; ++k) {
+                        if (b[k] + most * change[k] < 0.0) most = b[k] / -change[k];
+                    }
+                }
+            }
+            return most;
+        },
+        [](double a, double b) { return std::min(a, b); });
     tbb::parallel_for(std::size_t{0}, leaves.size(), [&](std::size_t i) {
         const std::uint32_t n = leaves[i];
         for (int s : {kUpper, kLower}) {
@@ -151,6 +171,7 @@ void Extrapolate(const std::vector<std::uint32_t>& leaves, const LeafLight& leaf
             for (int k = 0; k < channels; ++k) b[k] = std::max(b[k] + factor * change[k], 0.0);
         }
     });
+    return factor;
 }
 
 }  // namespace leaflux
