@@ -197,7 +197,8 @@ struct ClientCommand {
     std::int64_t number = 1;
     bool leaves = true, structures = false;
     double epsilon = 1e-4;
-    int timeoutS = 600;
+    ClientTimeouts timeouts;
+    double timeoutS = 0.0;  // 0: the defaults of ClientTimeouts
 };
 
 // Sends one request to leafluxd and prints the reply in protobuf text format.
@@ -211,12 +212,15 @@ int RunClient(const ClientCommand& command, const v1::Request& request) {
         }
         serverKey = *key;
     }
-    Client client(command.endpoint, serverKey, command.timeoutS * 1000);
+    ClientTimeouts timeouts = command.timeouts;
+    if (command.timeoutS > 0.0)
+        timeouts = ClientTimeouts::All(static_cast<int>(1000 * command.timeoutS));
     v1::Reply reply;
     try {
+        Client client(command.endpoint, serverKey, timeouts);
         reply = client.Call(request);
     } catch (const ClientError& e) {
-        spdlog::error("{}: {}", command.endpoint, e.what());
+        spdlog::error("{}", e.what());  // names the endpoint
         return 4;
     }
     std::string text;
@@ -374,7 +378,18 @@ int main(int argc, char** argv) {
     CLI::App* clientApp = app.add_subcommand("client", "Talk to a running leafluxd by hand");
     clientApp->require_subcommand(1);
     clientApp->add_option("--endpoint", client.endpoint, "leafluxd's endpoint");
-    clientApp->add_option("--timeout", client.timeoutS, "Seconds to wait for the reply");
+    clientApp->add_option("--timeout", client.timeoutS,
+                          "Seconds to wait for any reply (default: as the next three say)");
+    clientApp
+        ->add_option("--status-timeout-ms", client.timeouts.statusMs,
+                     "Status, close, shutdown: milliseconds to wait for the reply")
+        ->capture_default_str();
+    clientApp
+        ->add_option("--scene-timeout-ms", client.timeouts.sceneMs,
+                     "open, cycle: milliseconds to wait for the reply, plus --per-organ-ms for "
+                     "each organ of the scene")
+        ->capture_default_str();
+    clientApp->add_option("--per-organ-ms", client.timeouts.perOrganMs)->capture_default_str();
     clientApp
         ->add_option("--curve-server-key", client.curveServerKeyFile,
                      "File with the daemon's CurveZMQ public key, when it uses one")
