@@ -1,12 +1,17 @@
 // leaflux: the one-shot command line. `solve` lights a scene file, `generate` writes a
 // procedural tree or plantation as a scene file.
+#include <fcntl.h>
 #include <google/protobuf/text_format.h>
 #include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -200,6 +205,17 @@ struct ClientCommand {
     ClientTimeouts timeouts;
     double timeoutS = 0.0;  // 0: the defaults of ClientTimeouts
 };
+
+// Writes `text` to `path` readable by its owner alone (0600), whatever the file was before.
+void WriteSecret(const std::string& path, const std::string& text) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    if (fd < 0) throw InputError(ErrorCode::kIo, path, std::strerror(errno));
+    const bool written = ::fchmod(fd, 0600) == 0 &&
+                         ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
+    const int error = errno;
+    ::close(fd);
+    if (!written) throw InputError(ErrorCode::kIo, path, std::strerror(error));
+}
 
 // Sends one request to leafluxd and prints the reply in protobuf text format.
 int RunClient(const ClientCommand& command, const v1::Request& request) {
@@ -481,7 +497,7 @@ int main(int argc, char** argv) {
         }
         if (keygenApp->parsed()) {
             const CurveKeyPair keys = CurveKeyPair::Generate();
-            std::ofstream(keyPrefix + ".secret") << keys.secretKey << '\n';
+            WriteSecret(keyPrefix + ".secret", keys.secretKey + "\n");
             std::ofstream(keyPrefix + ".public") << keys.publicKey << '\n';
             std::cout << "wrote " << keyPrefix << ".secret and " << keyPrefix << ".public"
                       << std::endl;
