@@ -32,9 +32,9 @@ start_daemon() {  # port, log
     fail "leafluxd did not answer on port $1"
 }
 wait_for_line() {  # file, pattern, seconds
-    for _ in $(seq $((10 * $3))); do
+    for _ in $(seq $((50 * $3))); do
         grep -q "$2" "$1" 2> /dev/null && return 0
-        sleep 0.1
+        sleep 0.02
     done
     fail "no '$2' in $1 within $3 s"
 }
@@ -49,9 +49,10 @@ kill_and_restart() {  # file, pattern, port, log
 port=$((20000 + RANDOM % 20000))
 scenario=$source/growth_stub/scenarios/wall-hole.txtpb
 cycles=10
-# Monte Carlo with enough paths that a cycle takes a while: the kill lands in a solve.
+# Monte Carlo with enough paths that a cycle takes a while (cycles 5 to 10 together about
+# a second): the kill lands in a solve.
 grow=("$build/growth_stub/leaflux-grow" --scenario "$scenario" --cycles "$cycles" --solver mc
-      --samples 512 --cycle-timeout 4)
+      --samples 2048 --cycle-timeout 4)
 
 # leaflux-grow: uninterrupted, then killed after cycle 4.
 start_daemon "$port" "$out/reference.log"
