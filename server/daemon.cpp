@@ -558,11 +558,22 @@ std::string TooLargeReply(std::size_t bytes, std::size_t frames, const std::stri
 struct DaemonDispatcher::Pending {
     Respond respond;
     std::uint64_t requestId = 0;
-    std::atomic<bool> answered{false};
+    std::atomic<bool> answered{false};  // whoever sets it first answers
+};
+
+struct DaemonDispatcher::InFlight {
+    void Finish(const std::shared_ptr<Pending>& request, std::string reply) {
+        if (!request->answered.exchange(true)) request->respond(std::move(reply));
+        std::lock_guard lock(mutex);
+        pending.erase(request);
+    }
+
+    std::mutex mutex;
+    std::set<std::shared_ptr<Pending>> pending;
 };
 
 DaemonDispatcher::DaemonDispatcher(Daemon& daemon, KeyedExecutor& executor)
-    : daemon_(daemon), executor_(executor) {}
+    : daemon_(daemon), executor_(executor), inFlight_(std::make_shared<InFlight>()) {}
 
 namespace {
 
@@ -595,21 +606,18 @@ void DaemonDispatcher::operator()(std::string payload, Respond respond) {
     pending->respond = std::move(respond);
     pending->requestId = request->request_id();
     {
-        std::lock_guard lock(mutex_);
-        pending_.insert(pending);
+        std::lock_guard lock(inFlight_->mutex);
+        inFlight_->pending.insert(pending);
     }
     executor_.Submit(
         Daemon::KeyOf(*request),
-        [this, request, pending] { Finish(pending, daemon_.Handle(*request).SerializeAsString()); },
-        [this, pending] {
-            Finish(pending, ShuttingDown(pending->requestId, "the daemon is stopping: not run"));
+        [&daemon = daemon_, inFlight = inFlight_, request, pending] {
+            inFlight->Finish(pending, daemon.Handle(*request).SerializeAsString());
+        },
+        [inFlight = inFlight_, pending] {
+            inFlight->Finish(pending,
+                             ShuttingDown(pending->requestId, "the daemon is stopping: not run"));
         });
-}
-
-void DaemonDispatcher::Finish(const std::shared_ptr<Pending>& pending, std::string reply) {
-    if (!pending->answered.exchange(true)) pending->respond(std::move(reply));
-    std::lock_guard lock(mutex_);
-    pending_.erase(pending);
 }
 
 void DaemonDispatcher::StopTaking() {
@@ -618,15 +626,15 @@ void DaemonDispatcher::StopTaking() {
 }
 
 std::size_t DaemonDispatcher::Running() const {
-    std::lock_guard lock(mutex_);
-    return pending_.size();
+    std::lock_guard lock(inFlight_->mutex);
+    return inFlight_->pending.size();
 }
 
 void DaemonDispatcher::AbandonRunning() {
     std::set<std::shared_ptr<Pending>> running;
     {
-        std::lock_guard lock(mutex_);
-        running = pending_;
+        std::lock_guard lock(inFlight_->mutex);
+        running = inFlight_->pending;
     }
     for (const std::shared_ptr<Pending>& pending : running) {
         if (!pending->answered.exchange(true)) {

@@ -128,12 +128,13 @@ class DaemonDispatcher {
 
   private:
     struct Pending;
-    void Finish(const std::shared_ptr<Pending>& pending, std::string reply);
+    // The requests submitted and not answered; shared with the jobs, which may outlive the
+    // dispatcher (an executor joined after it).
+    struct InFlight;
 
     Daemon& daemon_;
     KeyedExecutor& executor_;
-    mutable std::mutex mutex_;
-    std::set<std::shared_ptr<Pending>> pending_;  // submitted and not answered
+    std::shared_ptr<InFlight> inFlight_;
     std::atomic<bool> stopping_{false};
 };
 
