@@ -68,6 +68,7 @@ class Client:
         self._per_organ_s = per_organ_s
         self._next_id = 1
         self._organs = {}  # by session: organs sent, removals aside
+        self._max_message_bytes = None  # the daemon's, once asked (0: not told)
         self.reconnect()
 
     def __enter__(self):
@@ -78,6 +79,7 @@ class Client:
 
     def reconnect(self):
         """A new connection to the same endpoint: replies to the old one are never read."""
+        self._max_message_bytes = None  # perhaps another daemon now
         if self._socket is not None:
             self._socket.close()
         self._socket = self._context.socket(zmq.DEALER)
@@ -106,7 +108,19 @@ class Client:
         request_id = request.request_id = self._next_id
         self._next_id += 1
         timeout_s = self._timeout_s(request)
-        self._socket.send_multipart([b"", request.SerializeToString()])
+        payload = request.SerializeToString()
+        # ZeroMQ cuts off, unanswered, a request over twice the daemon's limit: a large one
+        # is checked against the limit first (asked once a connection).
+        if len(payload) > 1 << 20 and request.WhichOneof("body") != "status":
+            if self._max_message_bytes is None:
+                self._max_message_bytes = self.status().max_message_bytes
+            if 0 < self._max_message_bytes < len(payload):
+                error = pb.Error(code=pb.ERROR_CODE_TOO_LARGE, message=(
+                    f"the request of {len(payload)} bytes exceeds the limit of leafluxd at "
+                    f"{self.endpoint}, {self._max_message_bytes} bytes (--max-message-mb): "
+                    "not sent"))
+                raise LeafluxError(error)
+        self._socket.send_multipart([b"", payload])
         deadline = time.monotonic() + timeout_s
         while True:
             left_ms = max(0, int(1000 * (deadline - time.monotonic())))

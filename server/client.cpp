@@ -35,6 +35,7 @@ Client::Client(const std::string& endpoint, const std::string& curveServerKey,
 }
 
 void Client::Reconnect() {
+    maxMessageBytes_.reset();  // perhaps another daemon now
     try {
         connection_ = std::make_unique<ClientConnection>(context_, endpoint_, curveServerKey_);
     } catch (const std::exception& e) {
@@ -71,6 +72,17 @@ v1::Reply Client::Call(v1::Request request) {
     const int timeoutMs = TimeoutMs(request);
     std::string bytes, answer;
     request.SerializeToString(&bytes);
+    constexpr std::size_t kAskLimitBytes = 1 << 20;
+    if (bytes.size() > kAskLimitBytes && !request.has_status()) {
+        if (!maxMessageBytes_) maxMessageBytes_ = Status().max_message_bytes();
+        if (*maxMessageBytes_ > 0 && bytes.size() > static_cast<std::size_t>(*maxMessageBytes_)) {
+            throw ClientError(Failure(
+                v1::ERROR_CODE_TOO_LARGE,
+                fmt::format("the request of {} bytes exceeds the limit of leafluxd at {}, {} "
+                            "bytes (--max-message-mb): not sent",
+                            bytes.size(), endpoint_, *maxMessageBytes_)));
+        }
+    }
     connection_->Send(bytes);
     using Clock = std::chrono::steady_clock;
     const Clock::time_point deadline = Clock::now() + std::chrono::milliseconds(timeoutMs);

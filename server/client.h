@@ -3,13 +3,17 @@
 //
 // Every request gets a new request id and only the reply of that id is taken: a late reply
 // to a request given up on is dropped. A request unanswered within its timeout is an
-// ERROR_CODE_IO ClientError naming the endpoint, and the connection is made anew.
+// ERROR_CODE_IO ClientError naming the endpoint, and the connection is made anew. Before
+// sending a request of over 1 MiB the client learns the daemon's message limit (Status,
+// once a connection) and refuses a request over it with ERROR_CODE_TOO_LARGE: ZeroMQ would
+// cut off one over twice the limit unanswered.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -77,7 +81,8 @@ class Client {
     zmq::context_t context_;
     std::unique_ptr<ClientConnection> connection_;
     std::uint64_t nextRequest_ = 1;
-    std::map<std::string, std::int64_t> organs_;  // by session: organs sent, removals aside
+    std::map<std::string, std::int64_t> organs_;   // by session: organs sent, removals aside
+    std::optional<std::int64_t> maxMessageBytes_;  // the daemon's, once asked (0: not told)
 };
 
 }  // namespace leaflux

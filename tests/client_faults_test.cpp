@@ -73,6 +73,24 @@ TEST(ClientTimeout, NoDaemonIsAnErrorNamingTheEndpointWithinTheTimeout) {
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
 }
 
+// A request over twice the daemon's limit would be cut off by ZeroMQ, unanswered: the
+// client learns the limit and refuses it with TOO_LARGE, at once, instead of timing out.
+TEST(ClientLimits, ARequestOverTheDaemonsLimitIsTooLargeNotATimeout) {
+    test::DaemonProcess daemon({"--max-message-mb", "1"});
+    Client client(daemon.Endpoint(), "", 5000);
+    v1::OpenSession open = OpenRequest().open_session();
+    open.mutable_scene()->mutable_nodes(1)->set_name(std::string(3 << 20, 'n'));  // 3 MiB
+    const auto start = std::chrono::steady_clock::now();
+    try {
+        client.Open(open);
+        FAIL() << "a 3 MiB request to a daemon of 1 MiB was answered";
+    } catch (const ClientError& e) {
+        EXPECT_EQ(e.Error().code(), v1::ERROR_CODE_TOO_LARGE) << e.what();
+    }
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 4.0);
+    EXPECT_EQ(client.Status().session_count(), 0);  // and the connection still serves
+}
+
 // Status has its own path: with every worker busy on a slow cycle it is answered at once,
 // while both cycles are still solving.
 TEST_F(ClientOnLoopback, StatusIsAnsweredWhileEveryWorkerSolves) {

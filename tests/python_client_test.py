@@ -3,7 +3,9 @@
 
 1. a timeout names the endpoint, and the late reply of the request given up on is never
    taken for the answer to the next one;
-2. a cycle given `resync=` survives a daemon killed (SIGKILL) and started again on the same
+2. a request over twice the daemon's limit, which ZeroMQ would cut off unanswered, is
+   refused with TOO_LARGE at once;
+3. a cycle given `resync=` survives a daemon killed (SIGKILL) and started again on the same
    endpoint: it reconnects, resyncs and sends the cycle again, with the light it would have
    had.
 
@@ -19,7 +21,7 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "examples"))
-from leaflux_client import Client, pb  # noqa: E402
+from leaflux_client import Client, LeafluxError, pb  # noqa: E402
 
 BUILD = sys.argv[1] if len(sys.argv) > 1 else os.environ.get("LEAFLUX_BUILD", "build/release")
 
@@ -29,10 +31,11 @@ def fail(message):
     sys.exit(1)
 
 
-def start(endpoint="tcp://127.0.0.1:*"):
+def start(endpoint="tcp://127.0.0.1:*", max_message_mb=256):
     log = tempfile.NamedTemporaryFile(suffix=".log", delete=False).name
     daemon = subprocess.Popen([os.path.join(BUILD, "server", "leafluxd"), "--bind", endpoint,
-                               "--log-file", log, "--solver-threads", "1"],
+                               "--log-file", log, "--solver-threads", "1",
+                               "--max-message-mb", str(max_message_mb)],
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     for _ in range(500):
         with open(log) as text:
@@ -100,6 +103,26 @@ def late_reply_dropped():
         daemon.wait()
 
 
+def too_large_refused():
+    daemon, endpoint = start(max_message_mb=1)
+    try:
+        big = scene(1)
+        big.nodes[1].name = "n" * (3 << 20)  # 3 MiB: ZeroMQ would cut it off unanswered
+        with Client(endpoint, timeout_s=5) as client:
+            started = time.monotonic()
+            try:
+                client.open(big)
+                fail("a 3 MiB request to a daemon of 1 MiB was answered")
+            except LeafluxError as e:
+                if e.code != "ERROR_CODE_TOO_LARGE" or time.monotonic() - started > 4:
+                    fail(f"a 3 MiB request: {e} after {time.monotonic() - started:.1f} s")
+            client.status()
+        print("a request over the daemon's limit is refused with TOO_LARGE, not a timeout")
+    finally:
+        daemon.kill()
+        daemon.wait()
+
+
 def survives_a_restart():
     endpoint = f"tcp://127.0.0.1:{free_port()}"
     settings = pb.SolverSettings(solver=pb.SOLVER_KIND_HRC)
@@ -133,4 +156,5 @@ def survives_a_restart():
 
 if __name__ == "__main__":
     late_reply_dropped()
+    too_large_refused()
     survives_a_restart()
