@@ -6,7 +6,11 @@ Each cycle the rosette makes a new leaf (a flat blade at the golden angle, raise
 every leaf grows in proportion to the PAR it absorbed: only the new leaf is added and
 only the leaves that grew are updated (their frame's scale changes).
 
+A daemon that restarts, or a cycle that goes unanswered, costs nothing but time: the
+script keeps the nodes the daemon has lit and hands them back (Client.cycle's `resync`).
+
 Usage: foreign_growth.py [--endpoint tcp://…] [--cycles 12]   (no endpoint: starts leafluxd)
+                         [--samples N] (Monte Carlo instead of HRC) [--csv rows.csv]
 """
 import argparse
 import math
@@ -54,16 +58,27 @@ def leaf_node(index, area_m2):
     return node
 
 
-def grow(client, cycles):
-    session = client.open(scene(), pb.SolverSettings(solver=pb.SOLVER_KIND_HRC, epsilon=1e-4), "rosette")
+def grow(client, cycles, settings, csv=None):
+    session = client.open(scene(), settings, "rosette")
     areas = []  # m², per leaf
     new, changed = [], []
-    print(f"{'cycle':>5} {'leaves':>6} {'area_m2':>8} {'absorbed_W':>10} {'biomass_g':>9} {'sent':>5}")
+    lit = {}  # the leaves as the daemon last lit them, by node id
+
+    def as_before():  # the session's scene before the cycle under way, to resync it
+        s = scene()
+        s.nodes.extend(lit[node] for node in sorted(lit))
+        return s, settings
+
+    print(f"{'cycle':>5} {'leaves':>6} {'area_m2':>8} {'absorbed_W':>10} {'biomass_g':>9} {'sent':>5}",
+          flush=True)
+    rows = open(csv, "w") if csv else None
     biomass = 0.0
     for number in range(1, cycles + 1):
         areas.append(0.002)  # a new leaf each cycle
         new = [leaf_node(len(areas) - 1, areas[-1])]
-        result = client.cycle(session, number, added=new, updated=changed, bands=["PAR"])
+        result = client.cycle(session, number, added=new, updated=changed, bands=["PAR"],
+                              resync=as_before)
+        lit.update((n.id, n) for n in new + changed)
         absorbed = {o.node: band_light(o, "PAR").absorbed_w for o in result.organs if o.node >= 100}
         assert len(absorbed) == len(areas), "every leaf gets its light"
         total = sum(absorbed.values())
@@ -76,21 +91,33 @@ def grow(client, cycles):
                 areas[node - 100] += SLA_M2_PER_G * produced * watts / total
                 changed.append(leaf_node(node - 100, areas[node - 100]))
         print(f"{number:>5} {len(areas):>6} {sum(areas):>8.4f} {total:>10.3f} {biomass:>9.3f} "
-              f"{len(new) + len(changed):>5}")
+              f"{len(new) + len(changed):>5}", flush=True)
+        if rows:
+            rows.write(f"{number},{len(areas)},{sum(areas)!r},{total!r},{biomass!r}\n")
     client.close(session)
+    if rows:
+        rows.close()
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--endpoint")
     parser.add_argument("--cycles", type=int, default=12)
+    parser.add_argument("--samples", type=int, help="Monte Carlo paths per leaf (default: HRC)")
+    parser.add_argument("--cycle-timeout", type=float, default=60.0,
+                        help="seconds to wait for a cycle's light before resyncing (default 60)")
+    parser.add_argument("--csv", help="a row per cycle, at full precision")
     args = parser.parse_args()
+    settings = pb.SolverSettings(solver=pb.SOLVER_KIND_HRC, epsilon=1e-4)
+    if args.samples:
+        settings = pb.SolverSettings(solver=pb.SOLVER_KIND_MONTE_CARLO, samples=args.samples)
     if args.endpoint:
-        with Client(args.endpoint) as client:
-            grow(client, args.cycles)
+        with Client(args.endpoint, scene_timeout_s=args.cycle_timeout) as client:
+            grow(client, args.cycles, settings, args.csv)
     else:
-        with LocalDaemon() as daemon, Client(daemon.endpoint) as client:
-            grow(client, args.cycles)
+        with LocalDaemon() as daemon, Client(daemon.endpoint,
+                                             scene_timeout_s=args.cycle_timeout) as client:
+            grow(client, args.cycles, settings, args.csv)
 
 
 if __name__ == "__main__":

@@ -8,9 +8,17 @@ generates (build/release/proto, or $LEAFLUX_BUILD/proto): examples find it by th
         session = client.open(scene, pb.SolverSettings(solver=pb.SOLVER_KIND_HRC, epsilon=1e-4))
         result = client.cycle(session, 1, added=[...], bands=["PAR"])
         for organ in result.organs: ...
+
+Every request gets a new request id and only the reply of that id is taken (a late reply to
+a request given up on is dropped). A request unanswered in time raises TimeoutError naming
+the endpoint, and the connection is made anew. Given `resync` (a function returning the
+session's whole scene and settings as they were before this cycle), `cycle` survives a
+daemon restart or a lost reply: it reconnects, resyncs the session and sends the cycle once
+more.
 """
 import os
 import sys
+import time
 
 # The build whose modules and programs the examples use: LEAFLUX_BUILD, or build/release.
 _build = os.environ.get("LEAFLUX_BUILD") or os.path.join(
@@ -35,14 +43,33 @@ class LeafluxError(Exception):
         super().__init__(f"{self.code}{where}: {error.message}")
 
 
+def _organs(nodes):
+    return sum(1 for n in nodes if n.HasField("organ"))
+
+
 class Client:
-    def __init__(self, endpoint="tcp://127.0.0.1:5555", timeout_s=600):
+    """A connection to leafluxd.
+
+    Timeouts: Status, close and shutdown wait `status_timeout_s`; open, resync and cycle,
+    which validate or solve a scene, wait `scene_timeout_s` plus `per_organ_s` for each
+    organ of the session's scene (as far as this client sent them). `timeout_s`, when
+    given, is the wait of every request.
+    """
+
+    def __init__(self, endpoint="tcp://127.0.0.1:5555", timeout_s=None, status_timeout_s=30.0,
+                 scene_timeout_s=60.0, per_organ_s=0.01):
+        self.endpoint = endpoint
         self._context = zmq.Context.instance()
-        self._socket = self._context.socket(zmq.DEALER)
-        self._socket.setsockopt(zmq.LINGER, 0)
-        self._socket.connect(endpoint)
-        self._timeout_ms = int(timeout_s * 1000)
+        self._socket = None
+        if timeout_s is not None:
+            status_timeout_s = scene_timeout_s = timeout_s
+            per_organ_s = 0.0
+        self._status_timeout_s, self._scene_timeout_s = status_timeout_s, scene_timeout_s
+        self._per_organ_s = per_organ_s
         self._next_id = 1
+        self._organs = {}  # by session: organs sent, removals aside
+        self._max_message_bytes = None  # the daemon's, once asked (0: not told)
+        self.reconnect()
 
     def __enter__(self):
         return self
@@ -50,18 +77,69 @@ class Client:
     def __exit__(self, *exc):
         self._socket.close()
 
+    def reconnect(self):
+        """A new connection to the same endpoint: replies to the old one are never read."""
+        self._max_message_bytes = None  # perhaps another daemon now
+        if self._socket is not None:
+            self._socket.close()
+        self._socket = self._context.socket(zmq.DEALER)
+        self._socket.setsockopt(zmq.LINGER, 0)
+        if "[" in self.endpoint:
+            self._socket.setsockopt(zmq.IPV6, 1)
+        self._socket.connect(self.endpoint)
+
+    def _timeout_s(self, request):
+        kind = request.WhichOneof("body")
+        if kind == "open_session":
+            organs = _organs(request.open_session.scene.nodes)
+        elif kind == "resync":
+            organs = _organs(request.resync.scene.nodes)
+        elif kind == "cycle":
+            organs = (self._organs.get(request.cycle.session, 0)
+                      + _organs(request.cycle.delta.added))
+        else:
+            return self._status_timeout_s
+        return self._scene_timeout_s + self._per_organ_s * organs
+
     def call(self, request):
-        """Sends a Request, returns its Reply (raises LeafluxError on an Error reply)."""
+        """Sends a Request, returns its Reply (raises LeafluxError on an Error reply,
+        TimeoutError when none comes in time)."""
         request.version = pb.PROTOCOL_VERSION_CURRENT
-        request.request_id = self._next_id
+        request_id = request.request_id = self._next_id
         self._next_id += 1
-        self._socket.send_multipart([b"", request.SerializeToString()])
-        if not self._socket.poll(self._timeout_ms):
-            raise TimeoutError(f"no reply from leafluxd within {self._timeout_ms / 1000} s")
-        reply = pb.Reply()
-        reply.ParseFromString(self._socket.recv_multipart()[-1])
+        timeout_s = self._timeout_s(request)
+        payload = request.SerializeToString()
+        # ZeroMQ cuts off, unanswered, a request over twice the daemon's limit: a large one
+        # is checked against the limit first (asked once a connection).
+        if len(payload) > 1 << 20 and request.WhichOneof("body") != "status":
+            if self._max_message_bytes is None:
+                self._max_message_bytes = self.status().max_message_bytes
+            if 0 < self._max_message_bytes < len(payload):
+                error = pb.Error(code=pb.ERROR_CODE_TOO_LARGE, message=(
+                    f"the request of {len(payload)} bytes exceeds the limit of leafluxd at "
+                    f"{self.endpoint}, {self._max_message_bytes} bytes (--max-message-mb): "
+                    "not sent"))
+                raise LeafluxError(error)
+        self._socket.send_multipart([b"", payload])
+        deadline = time.monotonic() + timeout_s
+        while True:
+            left_ms = max(0, int(1000 * (deadline - time.monotonic())))
+            if not self._socket.poll(left_ms):
+                self.reconnect()  # a late reply must not answer the next request
+                raise TimeoutError(f"no reply from leafluxd at {self.endpoint} within "
+                                   f"{timeout_s:g} s (is it running? busy with a long solve?)")
+            reply = pb.Reply()
+            reply.ParseFromString(self._socket.recv_multipart()[-1])
+            # Id 0: the daemon could not read the request's id (it did not decode).
+            if reply.request_id == request_id or (reply.request_id == 0
+                                                  and reply.HasField("error")):
+                break
         if reply.HasField("error"):
             raise LeafluxError(reply.error)
+        if request.WhichOneof("body") == "cycle":
+            session = request.cycle.session
+            self._organs[session] = (self._organs.get(session, 0)
+                                     + _organs(request.cycle.delta.added))
         return reply
 
     def open(self, scene, settings=None, species=""):
@@ -71,11 +149,29 @@ class Client:
         if settings is not None:
             request.open_session.settings.CopyFrom(settings)
         request.open_session.species = species
-        return self.call(request).opened.session
+        session = self.call(request).opened.session
+        self._organs[session] = _organs(scene.nodes)
+        return session
+
+    def resync(self, session, scene, settings=None, last_cycle=0):
+        """Gives the daemon the session's whole scene under its id (after a restart, or a
+        cycle gone unanswered); `last_cycle`: the number of the last cycle it includes."""
+        request = pb.Request()
+        request.resync.session = session
+        request.resync.scene.CopyFrom(scene)
+        if settings is not None:
+            request.resync.settings.CopyFrom(settings)
+        request.resync.last_cycle = last_cycle
+        self.call(request)
+        self._organs[session] = _organs(scene.nodes)
 
     def cycle(self, session, number, added=(), updated=(), removed=(), suns=None, bands=(),
-              leaves=True, structures=False):
-        """Sends one cycle's delta; returns the pb.CycleResult."""
+              leaves=True, structures=False, resync=None):
+        """Sends one cycle's delta; returns the pb.CycleResult.
+
+        `resync`: a function returning (scene, settings), the session as it was before this
+        cycle. Given it, a cycle unanswered in time, or whose session the daemon lost (it
+        restarted), is sent once more after a new connection and a Resync."""
         request = pb.Request()
         c = request.cycle
         c.session, c.number = session, number
@@ -86,6 +182,17 @@ class Client:
             c.suns.extend(suns)
         c.outputs.leaves, c.outputs.structures = leaves, structures
         c.outputs.bands.extend(bands)
+        try:
+            return self.call(request).cycle
+        except (TimeoutError, LeafluxError) as e:
+            lost = isinstance(e, TimeoutError) or e.code == "ERROR_CODE_UNKNOWN_SESSION"
+            if resync is None or not lost:
+                raise
+            print(f"leaflux_client: cycle {number} of session {session}: {e}; reconnecting, "
+                  "resyncing and sending it again", file=sys.stderr)
+        self.reconnect()
+        scene, settings = resync()
+        self.resync(session, scene, settings, last_cycle=number - 1)
         return self.call(request).cycle
 
     def status(self, session=""):

@@ -1,4 +1,7 @@
 // leaflux-grow: grows the plants of a scenario for a number of cycles, lit by leafluxd.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <sstream>
@@ -14,6 +17,7 @@ int main(int argc, char** argv) {
     double epsilon = 0.0, spacing = 0.0, rowAzimuth = -1.0;
     int samples = 0;
     bool directOnly = false;
+    double statusTimeoutS = 30.0, cycleTimeoutS = 60.0, perOrganMs = 10.0;
     app.add_option("--scenario", scenarioPath, "Scenario file (growth_stub/scenarios/*.txtpb)")
         ->required()
         ->check(CLI::ExistingFile);
@@ -41,6 +45,19 @@ int main(int argc, char** argv) {
         ->check(CLI::PositiveNumber);
     app.add_option("--row-azimuth", rowAzimuth, "Override the stand's row direction (deg from +y)")
         ->check(CLI::Range(0.0, 360.0));
+    app.add_option("--status-timeout", statusTimeoutS,
+                   "Seconds to wait for the daemon's answer to a close")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    app.add_option("--cycle-timeout", cycleTimeoutS,
+                   "Seconds to wait for a cycle's light (and an open's or a resync's answer), "
+                   "plus --per-organ-ms for each organ; then the client reconnects, resyncs the "
+                   "session and sends the cycle once more")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    app.add_option("--per-organ-ms", perOrganMs, "See --cycle-timeout")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     app.add_flag("--quiet", options.quiet, "No line per cycle");
     CLI11_PARSE(app, argc, argv);
 
@@ -65,7 +82,11 @@ int main(int argc, char** argv) {
             if (!key) throw std::invalid_argument(curveKeyFile + ": not a Z85 CurveZMQ public key");
             serverKey = *key;
         }
-        Client client(endpoint, serverKey);
+        spdlog::set_default_logger(spdlog::stderr_color_mt("leaflux-grow"));
+        const ClientTimeouts timeouts{static_cast<int>(1000 * statusTimeoutS),
+                                      static_cast<int>(1000 * cycleTimeoutS),
+                                      static_cast<int>(perOrganMs)};
+        Client client(endpoint, serverKey, timeouts);
         grow::GrowthModel model(scenario);
         const auto records = grow::Run(scenario, model, options, client);
         const grow::CycleRecord& last = records.back();

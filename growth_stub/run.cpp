@@ -172,19 +172,16 @@ std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
         cycle.mutable_outputs()->add_bands(scenario.par_band());
 
         const auto start = std::chrono::steady_clock::now();
-        v1::CycleResult result;
-        try {
-            result = client.Cycle(cycle);
-        } catch (const ClientError& e) {
-            if (e.Error().code() != v1::ERROR_CODE_UNKNOWN_SESSION) throw;
-            // The daemon restarted: give it the scene as it was, then the cycle again.
+        // Unanswered in time, or lost by a restarted daemon: the client reconnects, gives
+        // the daemon the scene as it was before this cycle, and sends the cycle again.
+        const v1::CycleResult result = client.Cycle(cycle, [&] {
             v1::Resync resync;
             resync.set_session(session);
             *resync.mutable_scene() = SessionScene(scenario, model, sent);
             *resync.mutable_settings() = scenario.settings();
-            client.Resync(resync);
-            result = client.Cycle(cycle);
-        }
+            resync.set_last_cycle(c - 1);
+            return resync;
+        });
         sent = nodes;
         const std::map<NodeId, LeafLight> light =
             LeafLightOf(result, model, scenario.par_band(), options.branchLight);

@@ -31,7 +31,8 @@ struct CycleRecord {
 };
 
 // Opens a session for the scenario (settings as in it), runs the cycles and closes the
-// session. A daemon that lost the session (restarted) gets a Resync and the cycle again.
+// session. A cycle unanswered within the client's timeout, or whose session the daemon lost
+// (it restarted), is sent once more after a reconnection and a Resync (Client::Cycle).
 // Throws ClientError for a rejected request, std::runtime_error when a leaf got no light.
 // `model` grows in place (built from `scenario`, it may be inspected afterwards).
 std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,

@@ -1,9 +1,11 @@
 #include "server/daemon.h"
 
+#include <google/protobuf/io/coded_stream.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <chrono>
+#include <random>
 
 #include "server/executor.h"
 #include "solver/util/error.h"
@@ -128,8 +130,14 @@ v1::Reply ErrorReply(v1::ErrorCode code, const std::string& message, const std::
     return reply;
 }
 
-Session::Session(Scene scene, MeshLibrary meshes, SolverSettings settings)
-    : store_(std::move(scene)), meshes_(std::move(meshes)), settings_(std::move(settings)) {
+Session::Session(Scene scene, MeshLibrary meshes, SolverSettings settings, SceneLimits limits,
+                 std::int64_t lastCycle)
+    : store_(std::move(scene)),
+      meshes_(std::move(meshes)),
+      settings_(std::move(settings)),
+      limits_(limits),
+      lastCycle_(lastCycle) {
+    if (store_.Get().periodic) CheckPeriodicTile(store_.Get(), store_.Flat(), limits_);
     Count();
 }
 
@@ -142,6 +150,28 @@ void Session::Count() {
 
 v1::CycleResult Session::Run(const v1::Cycle& cycle) {
     const v1::TopologyDelta& delta = cycle.delta();
+    // Counts before any work they multiply, then the number.
+    if (cycle.outputs().bands_size() > kMaxBands) {
+        throw TooLarge("outputs.bands", "at most " + std::to_string(kMaxBands) + " bands, got " +
+                                            std::to_string(cycle.outputs().bands_size()));
+    }
+    if (static_cast<std::size_t>(cycle.suns_size()) > limits_.maxSuns) {
+        throw TooLarge("suns", "at most " + std::to_string(limits_.maxSuns) + " suns, got " +
+                                   std::to_string(cycle.suns_size()));
+    }
+    if (static_cast<std::size_t>(delta.added_size()) > limits_.maxNodes) {
+        // Removals take subtrees: the total is checked exactly once the delta is applied.
+        throw TooLarge("delta.added", "at most " + std::to_string(limits_.maxNodes) +
+                                          " nodes a session, got " +
+                                          std::to_string(delta.added_size()) + " added");
+    }
+    if (cycle.number() <= lastCycle_) {
+        throw InputError(ErrorCode::kInvalidArgument, "number",
+                         "cycle numbers are positive and increase: " +
+                             std::to_string(cycle.number()) + " does not follow the session's " +
+                             (lastCycle_ == 0 ? std::string("start")
+                                              : "last cycle, " + std::to_string(lastCycle_)));
+    }
     const bool unchanged = delta.added_size() == 0 && delta.updated_size() == 0 &&
                            delta.removed_size() == 0 && cycle.suns_size() == 0;
     std::string outputs;
@@ -152,6 +182,7 @@ v1::CycleResult Session::Run(const v1::Cycle& cycle) {
         result.mutable_statistics()->set_wall_seconds(0.0);
         result.mutable_statistics()->set_cpu_seconds(0.0);
         ++cycles_;
+        lastCycle_ = cycle.number();
         return result;
     }
     const Clock::time_point start = Clock::now();
@@ -160,6 +191,11 @@ v1::CycleResult Session::Run(const v1::Cycle& cycle) {
                   Milliseconds(start));
     v1::CycleResult result;
     try {
+        if (store_.Get().nodes.size() > limits_.maxNodes) {
+            throw TooLarge("delta.added",
+                           "the session would hold " + std::to_string(store_.Get().nodes.size()) +
+                               " nodes; at most " + std::to_string(limits_.maxNodes));
+        }
         result = Solve(cycle.outputs());
     } catch (...) {
         store_.Undo();
@@ -167,6 +203,7 @@ v1::CycleResult Session::Run(const v1::Cycle& cycle) {
     }
     Count();
     ++cycles_;
+    lastCycle_ = cycle.number();
     last_ = result;
     lastOutputs_ = std::move(outputs);
     return result;
@@ -216,7 +253,9 @@ v1::CycleResult Session::Solve(const v1::OutputRequest& outputs) const {
     SolverSettings settings = settings_;
     settings.hrc.lightVectors = lightVectors;
     Clock::time_point start = Clock::now();
-    const PreparedScene prepared(solved, store_.Flat());  // the bands do not change the geometry
+    FlatScene flat = store_.Flat();
+    CheckPeriodicTile(scene, flat, limits_);
+    const PreparedScene prepared(solved, std::move(flat));  // the bands do not change the geometry
     spdlog::debug("scene flattened and its ray engine built in {:.1f} ms", Milliseconds(start));
     start = Clock::now();
     const Solution solution = leaflux::Solve(prepared, settings);
@@ -300,6 +339,11 @@ v1::Reply Daemon::Handle(const v1::Request& request) {
             throw InputError(ErrorCode::kUnsupported, "version",
                              "is newer than this daemon understands");
         }
+        if (request.version() < v1::PROTOCOL_VERSION_CURRENT) {
+            throw InputError(
+                ErrorCode::kInvalidArgument, "version",
+                "must be PROTOCOL_VERSION_CURRENT (1), got " + std::to_string(request.version()));
+        }
         switch (request.body_case()) {
             case v1::Request::kOpenSession:
                 reply = Open(request.open_session());
@@ -326,6 +370,8 @@ v1::Reply Daemon::Handle(const v1::Request& request) {
         }
     } catch (const InputError& e) {
         reply = ErrorReply(ToProto(e.Code()), e.what(), e.Field(), e.Node().value_or(0));
+    } catch (const TooLarge& e) {
+        reply = ErrorReply(v1::ERROR_CODE_TOO_LARGE, e.what(), e.Field());
     } catch (const UnknownSession& e) {
         reply = ErrorReply(v1::ERROR_CODE_UNKNOWN_SESSION, e.what(), "session");
     } catch (const std::exception& e) {
@@ -374,10 +420,10 @@ v1::Reply Daemon::Open(const v1::OpenSession& request) {
         throw InputError(ErrorCode::kUnsupported, "scene.imports",
                          "the daemon reads no files: send the geometry");
     }
-    Scene scene = FromProto(request.scene(), "");
+    Scene scene = FromProto(request.scene(), "", limits_.scene);
     SolverSettings settings = Settings(request.settings());
     auto session = std::make_shared<Session>(std::move(scene), MeshesFromProto(request.scene()),
-                                             std::move(settings));
+                                             std::move(settings), limits_.scene);
     std::string id;
     {
         std::lock_guard lock(mutex_);
@@ -386,8 +432,11 @@ v1::Reply Daemon::Open(const v1::OpenSession& request) {
                 ErrorCode::kInvalidArgument, "open_session",
                 "the daemon serves at most " + std::to_string(limits_.maxSessions) + " sessions");
         }
-        id = "s" + std::to_string(nextSession_++);
-        sessions_[id] = std::move(session);
+        // Never an id in use (one a Resync brought back, say): an open never replaces.
+        do {
+            id = NewSessionId();
+        } while (sessions_.count(id));
+        sessions_.emplace(id, std::move(session));
     }
     spdlog::info("session {} opened", id);
     v1::Reply reply;
@@ -407,14 +456,21 @@ v1::Reply Daemon::RunCycle(const v1::Cycle& request) {
 v1::Reply Daemon::Resynchronise(const v1::Resync& request) {
     if (request.session().empty())
         throw InputError(ErrorCode::kInvalidArgument, "session", "is empty");
+    if (!IsSessionId(request.session())) {
+        throw InputError(ErrorCode::kInvalidArgument, "session",
+                         "is not an id this daemon issues (32 lowercase hexadecimal digits)");
+    }
+    if (request.last_cycle() < 0)
+        throw InputError(ErrorCode::kInvalidArgument, "last_cycle", "is negative");
     if (request.scene().imports_size() > 0 || request.scene().can_lights_size() > 0) {
         throw InputError(ErrorCode::kUnsupported, "scene.imports",
                          "the daemon reads no files: send the geometry");
     }
-    Scene scene = FromProto(request.scene(), "");
+    Scene scene = FromProto(request.scene(), "", limits_.scene);
     SolverSettings settings = Settings(request.settings());
-    auto session = std::make_shared<Session>(std::move(scene), MeshesFromProto(request.scene()),
-                                             std::move(settings));
+    auto session =
+        std::make_shared<Session>(std::move(scene), MeshesFromProto(request.scene()),
+                                  std::move(settings), limits_.scene, request.last_cycle());
     {
         std::lock_guard lock(mutex_);
         if (!sessions_.count(request.session()) && sessions_.size() >= limits_.maxSessions) {
@@ -434,18 +490,20 @@ v1::Reply Daemon::Status(const v1::StatusRequest& request) {
     v1::Reply reply;
     v1::StatusReply* status = reply.mutable_status();
     status->set_requests(requests_);
+    status->set_max_message_bytes(static_cast<std::int64_t>(limits_.maxMessageBytes));
     std::lock_guard lock(mutex_);  // counts only: never waits for a solve
-    for (const auto& [id, session] : sessions_) {
-        if (!request.session().empty() && id != request.session()) continue;
-        v1::SessionStatus* s = status->add_sessions();
-        s->set_session(id);
-        s->set_cycles(session->Cycles());
-        s->set_nodes(session->Nodes());
-        s->set_organs(session->Organs());
-    }
-    if (!request.session().empty() && status->sessions_size() == 0) {
+    status->set_session_count(static_cast<int>(sessions_.size()));
+    if (request.session().empty()) return reply;  // ids are credentials: none is listed
+    const auto it = sessions_.find(request.session());
+    if (it == sessions_.end()) {
         throw UnknownSession("unknown session '" + request.session() + "': open or resync it");
     }
+    v1::SessionStatus* s = status->add_sessions();
+    s->set_session(it->first);
+    s->set_cycles(it->second->Cycles());
+    s->set_last_cycle(it->second->LastCycle());
+    s->set_nodes(it->second->Nodes());
+    s->set_organs(it->second->Organs());
     return reply;
 }
 
@@ -459,22 +517,140 @@ v1::Reply Daemon::Close(const v1::CloseSession& request) {
     return reply;
 }
 
+std::string NewSessionId() {
+    // std::random_device reads the kernel's generator (/dev/urandom, getrandom).
+    thread_local std::random_device device;
+    std::string id;
+    for (int i = 0; i < 4; ++i) id += fmt::format("{:08x}", static_cast<std::uint32_t>(device()));
+    return id;
+}
+
+bool IsSessionId(const std::string& id) {
+    return id.size() == 32 && std::all_of(id.begin(), id.end(), [](char c) {
+               return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+           });
+}
+
+std::string TooLargeReply(std::size_t bytes, std::size_t frames, const std::string& head,
+                          std::size_t limitBytes) {
+    // Fields 1 (version) and 2 (request_id) come first in a serialised Request.
+    std::uint64_t requestId = 0;
+    google::protobuf::io::CodedInputStream in(reinterpret_cast<const std::uint8_t*>(head.data()),
+                                              static_cast<int>(head.size()));
+    for (std::uint32_t tag; (tag = in.ReadTag()) != 0;) {
+        std::uint64_t value = 0;
+        if ((tag & 7) != 0 || !in.ReadVarint64(&value)) break;  // not a varint
+        if (tag >> 3 == 2) {
+            requestId = value;
+            break;
+        }
+        if (tag >> 3 != 1) break;
+    }
+    v1::Reply reply = ErrorReply(
+        v1::ERROR_CODE_TOO_LARGE,
+        fmt::format("the message of {} bytes in {} frames exceeds the daemon's limit of {} bytes "
+                    "(--max-message-mb) or of frames",
+                    bytes, frames, limitBytes));
+    reply.set_request_id(requestId);
+    return reply.SerializeAsString();
+}
+
+struct DaemonDispatcher::Pending {
+    Respond respond;
+    std::uint64_t requestId = 0;
+    std::atomic<bool> answered{false};  // whoever sets it first answers
+};
+
+struct DaemonDispatcher::InFlight {
+    void Finish(const std::shared_ptr<Pending>& request, std::string reply) {
+        if (!request->answered.exchange(true)) request->respond(std::move(reply));
+        std::lock_guard lock(mutex);
+        pending.erase(request);
+    }
+
+    std::mutex mutex;
+    std::set<std::shared_ptr<Pending>> pending;
+};
+
+DaemonDispatcher::DaemonDispatcher(Daemon& daemon, KeyedExecutor& executor)
+    : daemon_(daemon), executor_(executor), inFlight_(std::make_shared<InFlight>()) {}
+
+namespace {
+
+std::string ShuttingDown(std::uint64_t requestId, const std::string& why) {
+    v1::Reply reply = ErrorReply(v1::ERROR_CODE_SHUTTING_DOWN, why);
+    reply.set_request_id(requestId);
+    return reply.SerializeAsString();
+}
+
+}  // namespace
+
+void DaemonDispatcher::operator()(std::string payload, Respond respond) {
+    auto request = std::make_shared<v1::Request>();
+    if (!request->ParseFromString(payload)) {
+        std::string out;
+        ErrorReply(v1::ERROR_CODE_PARSE, "the message is not a leaflux.v1.Request")
+            .SerializeToString(&out);
+        respond(std::move(out));
+        return;
+    }
+    if (stopping_) {
+        respond(ShuttingDown(request->request_id(), "the daemon is stopping: not run"));
+        return;
+    }
+    if (request->body_case() == v1::Request::kStatus) {  // counts only: never behind a solve
+        respond(daemon_.Handle(*request).SerializeAsString());
+        return;
+    }
+    auto pending = std::make_shared<Pending>();
+    pending->respond = std::move(respond);
+    pending->requestId = request->request_id();
+    {
+        std::lock_guard lock(inFlight_->mutex);
+        inFlight_->pending.insert(pending);
+    }
+    executor_.Submit(
+        Daemon::KeyOf(*request),
+        [&daemon = daemon_, inFlight = inFlight_, request, pending] {
+            inFlight->Finish(pending, daemon.Handle(*request).SerializeAsString());
+        },
+        [inFlight = inFlight_, pending] {
+            inFlight->Finish(pending,
+                             ShuttingDown(pending->requestId, "the daemon is stopping: not run"));
+        });
+}
+
+void DaemonDispatcher::StopTaking() {
+    stopping_ = true;
+    executor_.CancelQueued();
+}
+
+std::size_t DaemonDispatcher::Running() const {
+    std::lock_guard lock(inFlight_->mutex);
+    return inFlight_->pending.size();
+}
+
+void DaemonDispatcher::AbandonRunning() {
+    std::set<std::shared_ptr<Pending>> running;
+    {
+        std::lock_guard lock(inFlight_->mutex);
+        running = inFlight_->pending;
+    }
+    for (const std::shared_ptr<Pending>& pending : running) {
+        if (!pending->answered.exchange(true)) {
+            pending->respond(ShuttingDown(
+                pending->requestId,
+                "the daemon stopped before this request's solve ended (--grace-seconds): "
+                "nothing of it was kept"));
+        }
+    }
+}
+
 std::function<void(std::string, std::function<void(std::string)>)> DaemonDispatch(
     Daemon& daemon, KeyedExecutor& executor) {
-    return [&daemon, &executor](std::string payload, std::function<void(std::string)> respond) {
-        auto request = std::make_shared<v1::Request>();
-        if (!request->ParseFromString(payload)) {
-            std::string out;
-            ErrorReply(v1::ERROR_CODE_PARSE, "the message is not a leaflux.v1.Request")
-                .SerializeToString(&out);
-            respond(std::move(out));
-            return;
-        }
-        executor.Submit(Daemon::KeyOf(*request), [&daemon, request, respond = std::move(respond)] {
-            std::string out;
-            daemon.Handle(*request).SerializeToString(&out);
-            respond(std::move(out));
-        });
+    auto dispatcher = std::make_shared<DaemonDispatcher>(daemon, executor);
+    return [dispatcher](std::string payload, std::function<void(std::string)> respond) {
+        (*dispatcher)(std::move(payload), std::move(respond));
     };
 }
 

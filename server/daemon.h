@@ -3,7 +3,8 @@
 // Every request is decoded, dispatched by type to one handler and answered with a Reply;
 // each handler runs inside one try/catch, so a bad request gets a typed Error and never
 // takes the daemon down. A session changes only when a request succeeds: a delta is checked
-// whole before it is applied, and taken back if its solve fails.
+// whole before it is applied, and taken back if its solve fails. Counts a request
+// multiplies (bands, suns, nodes, periodic tile crossings) are capped before any work.
 #pragma once
 
 #include <atomic>
@@ -13,6 +14,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 
 #include "leaflux.pb.h"
@@ -22,20 +24,31 @@
 
 namespace leaflux {
 
+struct DaemonLimits {
+    std::size_t maxSessions = 64;
+    int solverThreads = 0;            // cores one solve may use; 0: all
+    SceneLimits scene;                // bands, suns (sun period steps included), nodes of a session
+    std::size_t maxMessageBytes = 0;  // the transport's limit, for Status (0: not told)
+};
+
 // One growth model's scene and solver settings.
 class Session {
   public:
-    Session(Scene scene, MeshLibrary meshes, SolverSettings settings);
+    // Throws TooLarge when the scene's periodic tile is too small for its geometry.
+    Session(Scene scene, MeshLibrary meshes, SolverSettings settings, SceneLimits limits,
+            std::int64_t lastCycle = 0);
 
-    // Checks a cycle's delta and suns against the scene they make, applies them and solves
-    // that scene for what the cycle's outputs ask; the checks and the geometry cost what
-    // the delta touches (SceneStore). Throws InputError (naming the field or node), and
-    // then the session is as it was: a delta whose solve fails is taken back. A cycle that
-    // changes nothing and asks what the last one asked gets the last one's light again.
+    // Checks a cycle's number, counts, delta and suns against the scene they make, applies
+    // them and solves that scene for what the cycle's outputs ask; the checks and the
+    // geometry cost what the delta touches (SceneStore). Throws InputError or TooLarge
+    // (naming the field or node), and then the session is as it was: a delta whose solve
+    // fails is taken back. A cycle that changes nothing and asks what the last one asked
+    // gets the last one's light again.
     v1::CycleResult Run(const v1::Cycle& cycle);
 
     // What Status reports; readable while the session solves.
     std::int64_t Cycles() const { return cycles_; }
+    std::int64_t LastCycle() const { return lastCycle_; }
     int Nodes() const { return nodes_; }
     int Organs() const { return organs_; }
 
@@ -48,18 +61,18 @@ class Session {
     SceneStore store_;
     MeshLibrary meshes_;
     SolverSettings settings_;
+    SceneLimits limits_;
     // The last cycle's result and the outputs it answered (serialised), for a cycle that
     // changes nothing: the solvers are deterministic, so it would get the same light.
     std::string lastOutputs_;
     std::optional<v1::CycleResult> last_;
-    std::atomic<std::int64_t> cycles_{0};
+    std::atomic<std::int64_t> cycles_{0}, lastCycle_{0};
     std::atomic<int> nodes_{0}, organs_{0};
 };
 
-struct DaemonLimits {
-    std::size_t maxSessions = 64;
-    int solverThreads = 0;  // cores one solve may use; 0: all
-};
+// A session id: 128 random bits as 32 lowercase hexadecimal digits.
+std::string NewSessionId();
+bool IsSessionId(const std::string& id);
 
 class Daemon {
   public:
@@ -85,21 +98,57 @@ class Daemon {
     SolverSettings Settings(const v1::SolverSettings& in) const;
 
     DaemonLimits limits_;
-    std::mutex mutex_;  // guards the map and the id counter, never held while solving
+    std::mutex mutex_;  // guards the map, never held while solving
     std::map<std::string, std::shared_ptr<Session>> sessions_;
-    std::uint64_t nextSession_ = 1;
     std::atomic<std::int64_t> requests_{0};
     std::atomic<bool> shutdown_{false};
 };
 
 class KeyedExecutor;
-// Decodes each message, runs it on `executor` in its session's order and answers through
-// the transport; garbage is answered at once.
+
+// Decodes each message and runs it on `executor` in its session's order, answering through
+// the transport; garbage is answered at once, and so is Status, on the serving thread:
+// it never waits behind a solve. When the daemon stops it refuses what is queued and, after
+// a grace, answers what still runs with ERROR_CODE_SHUTTING_DOWN.
+class DaemonDispatcher {
+  public:
+    using Respond = std::function<void(std::string)>;
+    DaemonDispatcher(Daemon& daemon, KeyedExecutor& executor);
+
+    void operator()(std::string payload, Respond respond);
+
+    // From now on every request is answered ERROR_CODE_SHUTTING_DOWN; so are the queued
+    // ones, at once.
+    void StopTaking();
+    // Requests still running (after StopTaking: the solves in flight).
+    std::size_t Running() const;
+    // Answers every running request with ERROR_CODE_SHUTTING_DOWN; their results, if they
+    // come, are dropped.
+    void AbandonRunning();
+
+  private:
+    struct Pending;
+    // The requests submitted and not answered; shared with the jobs, which may outlive the
+    // dispatcher (an executor joined after it).
+    struct InFlight;
+
+    Daemon& daemon_;
+    KeyedExecutor& executor_;
+    std::shared_ptr<InFlight> inFlight_;
+    std::atomic<bool> stopping_{false};
+};
+
+// A DaemonDispatcher as a transport's Dispatch.
 std::function<void(std::string, std::function<void(std::string)>)> DaemonDispatch(
     Daemon& daemon, KeyedExecutor& executor);
 
 // An Error reply.
 v1::Reply ErrorReply(v1::ErrorCode code, const std::string& message, const std::string& field = "",
                      std::uint64_t node = 0);
+
+// The typed reply to a message the transport refused for its size (`head`: its payload's
+// first bytes, from which the request id is read when they hold it).
+std::string TooLargeReply(std::size_t bytes, std::size_t frames, const std::string& head,
+                          std::size_t limitBytes);
 
 }  // namespace leaflux

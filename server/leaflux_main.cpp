@@ -1,12 +1,17 @@
 // leaflux: the one-shot command line. `solve` lights a scene file, `generate` writes a
 // procedural tree or plantation as a scene file.
+#include <fcntl.h>
 #include <google/protobuf/text_format.h>
 #include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -201,8 +206,20 @@ struct ClientCommand {
     std::int64_t number = 1;
     bool leaves = true, structures = false, strict = false;
     double epsilon = 1e-4;
-    int timeoutS = 600;
+    ClientTimeouts timeouts;
+    double timeoutS = 0.0;  // 0: the defaults of ClientTimeouts
 };
+
+// Writes `text` to `path` readable by its owner alone (0600), whatever the file was before.
+void WriteSecret(const std::string& path, const std::string& text) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    if (fd < 0) throw InputError(ErrorCode::kIo, path, std::strerror(errno));
+    const bool written = ::fchmod(fd, 0600) == 0 &&
+                         ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
+    const int error = errno;
+    ::close(fd);
+    if (!written) throw InputError(ErrorCode::kIo, path, std::strerror(error));
+}
 
 // Sends one request to leafluxd and prints the reply in protobuf text format.
 int RunClient(const ClientCommand& command, const v1::Request& request) {
@@ -215,12 +232,15 @@ int RunClient(const ClientCommand& command, const v1::Request& request) {
         }
         serverKey = *key;
     }
-    Client client(command.endpoint, serverKey, command.timeoutS * 1000);
+    ClientTimeouts timeouts = command.timeouts;
+    if (command.timeoutS > 0.0)
+        timeouts = ClientTimeouts::All(static_cast<int>(1000 * command.timeoutS));
     v1::Reply reply;
     try {
+        Client client(command.endpoint, serverKey, timeouts);
         reply = client.Call(request);
     } catch (const ClientError& e) {
-        spdlog::error("{}: {}", command.endpoint, e.what());
+        spdlog::error("{}", e.what());  // names the endpoint
         return 4;
     }
     std::string text;
@@ -380,7 +400,18 @@ int main(int argc, char** argv) {
     CLI::App* clientApp = app.add_subcommand("client", "Talk to a running leafluxd by hand");
     clientApp->require_subcommand(1);
     clientApp->add_option("--endpoint", client.endpoint, "leafluxd's endpoint");
-    clientApp->add_option("--timeout", client.timeoutS, "Seconds to wait for the reply");
+    clientApp->add_option("--timeout", client.timeoutS,
+                          "Seconds to wait for any reply (default: as the next three say)");
+    clientApp
+        ->add_option("--status-timeout-ms", client.timeouts.statusMs,
+                     "Status, close, shutdown: milliseconds to wait for the reply")
+        ->capture_default_str();
+    clientApp
+        ->add_option("--scene-timeout-ms", client.timeouts.sceneMs,
+                     "open, cycle: milliseconds to wait for the reply, plus --per-organ-ms for "
+                     "each organ of the scene")
+        ->capture_default_str();
+    clientApp->add_option("--per-organ-ms", client.timeouts.perOrganMs)->capture_default_str();
     clientApp
         ->add_option("--curve-server-key", client.curveServerKeyFile,
                      "File with the daemon's CurveZMQ public key, when it uses one")
@@ -473,7 +504,7 @@ int main(int argc, char** argv) {
         }
         if (keygenApp->parsed()) {
             const CurveKeyPair keys = CurveKeyPair::Generate();
-            std::ofstream(keyPrefix + ".secret") << keys.secretKey << '\n';
+            WriteSecret(keyPrefix + ".secret", keys.secretKey + "\n");
             std::ofstream(keyPrefix + ".public") << keys.publicKey << '\n';
             std::cout << "wrote " << keyPrefix << ".secret and " << keyPrefix << ".public"
                       << std::endl;

@@ -1,12 +1,14 @@
 #include "server/scene_proto.h"
 
 #include <google/protobuf/text_format.h>
+#include <spdlog/fmt/fmt.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <unordered_set>
 
 #include "server/text_format.h"
 #include "solver/io/importers.h"
@@ -200,7 +202,38 @@ Sun SunFromProto(const Scene& scene, const v1::Sun& in, const std::string& field
 
 namespace {
 
-void ReadSources(const v1::Scene& message, Scene& scene, const std::filesystem::path& base) {
+void ReadSources(const v1::Scene& message, Scene& scene, const std::filesystem::path& base,
+                 const SceneLimits& limits) {
+    if (static_cast<std::size_t>(message.suns_size()) > limits.maxSuns) {
+        throw TooLarge("suns", "at most " + std::to_string(limits.maxSuns) + " suns, got " +
+                                   std::to_string(message.suns_size()));
+    }
+    // Sun periods' steps, counted before any is expanded; suns given one by one count too.
+    double sunCount = message.suns_size();
+    for (int i = 0; i < message.sun_periods_size(); ++i) {
+        const v1::SunPeriod& p = message.sun_periods(i);
+        const std::string field = "sun_periods[" + std::to_string(i) + "]";
+        if (!(p.step_h() > 0.0) || !(p.end_h() > p.start_h()) || !(p.start_h() >= 0.0) ||
+            !(p.end_h() <= 24.0)) {
+            Fail(ErrorCode::kInvalidArgument, field,
+                 "needs 0 <= start_h < end_h <= 24 and step_h > 0");
+        }
+        if (p.day_of_year() < 1 || p.day_of_year() > 366 || !(std::abs(p.latitude_deg()) <= 90.0)) {
+            Fail(ErrorCode::kInvalidArgument, field,
+                 "needs a day of year in [1, 366] and a latitude in [-90, 90]");
+        }
+        const double steps = std::ceil((p.end_h() - p.start_h()) / p.step_h());
+        if (!(steps <= static_cast<double>(limits.maxSuns))) {
+            throw TooLarge(field + ".step_h", "makes " + fmt::format("{:g}", steps) +
+                                                  " sun positions; at most " +
+                                                  std::to_string(limits.maxSuns) + " suns");
+        }
+        sunCount += steps;
+        if (sunCount > static_cast<double>(limits.maxSuns)) {
+            throw TooLarge("sun_periods", "the suns and sun period steps make more than " +
+                                              std::to_string(limits.maxSuns) + " suns");
+        }
+    }
     for (int i = 0; i < message.suns_size(); ++i) {
         scene.sources.suns.push_back(
             SunFromProto(scene, message.suns(i), "suns[" + std::to_string(i) + "]"));
@@ -208,15 +241,6 @@ void ReadSources(const v1::Scene& message, Scene& scene, const std::filesystem::
     for (int i = 0; i < message.sun_periods_size(); ++i) {
         const v1::SunPeriod& p = message.sun_periods(i);
         const std::string field = "sun_periods[" + std::to_string(i) + "]";
-        if (!(p.step_h() > 0.0) || !(p.end_h() > p.start_h()) || p.start_h() < 0.0 ||
-            p.end_h() > 24.0) {
-            Fail(ErrorCode::kInvalidArgument, field,
-                 "needs 0 <= start_h < end_h <= 24 and step_h > 0");
-        }
-        if (p.day_of_year() < 1 || p.day_of_year() > 366 || std::abs(p.latitude_deg()) > 90.0) {
-            Fail(ErrorCode::kInvalidArgument, field,
-                 "needs a day of year in [1, 366] and a latitude in [-90, 90]");
-        }
         const auto suns = SunPositionsOverPeriod(
             p.latitude_deg(), p.day_of_year(), p.start_h(), p.end_h(), p.step_h(),
             PerBand(scene, p.normal_irradiance(), field + ".normal_irradiance"));
@@ -299,24 +323,48 @@ MeshLibrary MeshesFromProto(const v1::Scene& message) {
 void ReadImports(const v1::Scene& message, Scene& scene, const std::filesystem::path& base,
                  const ImportOptions& options);
 
+void CheckPeriodicTile(const Scene& scene, const FlatScene& flat, const SceneLimits& limits) {
+    if (!scene.periodic || flat.triangles.empty()) return;
+    const glm::dvec3 extent = flat.boundsMax - flat.boundsMin;
+    const double width = scene.periodic->xMax - scene.periodic->xMin;
+    const double depth = scene.periodic->yMax - scene.periodic->yMin;
+    if (extent.x > limits.maxTilesSpanned * width || extent.y > limits.maxTilesSpanned * depth) {
+        throw TooLarge("periodic",
+                       fmt::format("a tile of {:g} m × {:g} m under geometry {:g} m × {:g} m "
+                                   "wide: the geometry may span at most {:g} tiles each way",
+                                   width, depth, extent.x, extent.y, limits.maxTilesSpanned));
+    }
+}
+
 Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
-                const ImportOptions& options) {
+                const SceneLimits& limits, const ImportOptions& options) {
     if (message.version() > v1::PROTOCOL_VERSION_CURRENT) {
         Fail(ErrorCode::kUnsupported, "version", "is newer than this leaflux understands");
     }
+    if (message.version() < 0) {
+        Fail(ErrorCode::kInvalidArgument, "version",
+             "must be PROTOCOL_VERSION_CURRENT (1) or unset, got " +
+                 std::to_string(message.version()));
+    }
+    // Counts first, before any work they would multiply.
+    if (message.bands_size() > kMaxBands) {
+        throw TooLarge("bands", "at most " + std::to_string(kMaxBands) + " bands, got " +
+                                    std::to_string(message.bands_size()));
+    }
+    if (static_cast<std::size_t>(message.nodes_size()) > limits.maxNodes) {
+        throw TooLarge("nodes", "at most " + std::to_string(limits.maxNodes) +
+                                    " nodes a session, got " +
+                                    std::to_string(message.nodes_size()));
+    }
     const std::filesystem::path base(baseDirectory);
     Scene scene;
+    std::unordered_set<std::string> bandNames;
     for (const v1::Band& band : message.bands()) {
-        scene.bands.push_back({band.name(), band.wavelength_min_nm(), band.wavelength_max_nm()});
-    }
-    // Bands first: every per-band map below is read against them.
-    for (std::size_t b = 0; b < scene.bands.size(); ++b) {
-        for (std::size_t c = 0; c < b; ++c) {
-            if (scene.bands[c].name == scene.bands[b].name) {
-                Fail(ErrorCode::kAlreadyExists, "bands[" + scene.bands[b].name + "]",
-                     "is declared twice");
-            }
+        // Bands first: every per-band map below is read against them.
+        if (!bandNames.insert(band.name()).second) {
+            Fail(ErrorCode::kAlreadyExists, "bands[" + band.name() + "]", "is declared twice");
         }
+        scene.bands.push_back({band.name(), band.wavelength_min_nm(), band.wavelength_max_nm()});
     }
     for (const v1::Optics& optics : message.optics()) {
         Optics o;
@@ -348,7 +396,7 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
              MeshFromProto(surface.mesh(), "environment[" + surface.name() + "].mesh"),
              surface.optics()});
     }
-    ReadSources(message, scene, base);
+    ReadSources(message, scene, base, limits);
     if (message.has_periodic()) {
         const v1::PeriodicDomain& p = message.periodic();
         scene.periodic = PeriodicDomain{p.x_min(), p.y_min(), p.x_max(), p.y_max()};
@@ -454,7 +502,7 @@ Scene LoadSceneFile(const std::string& path, const ImportOptions& options) {
         Fail(error->unreadable ? ErrorCode::kIo : ErrorCode::kParse, error->where,
              error->unreadable ? "cannot open the scene file" : error->what);
     }
-    return FromProto(message, std::filesystem::path(path).parent_path().string(), options);
+    return FromProto(message, std::filesystem::path(path).parent_path().string(), {}, options);
 }
 
 void SaveSceneFile(const Scene& scene, const std::string& path) {

@@ -5,15 +5,43 @@
 // Scene::Validate: a Scene it returns is valid. Errors are InputError naming the field.
 #pragma once
 
+#include <cstddef>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "leaflux.pb.h"
 #include "solver/io/importers.h"
+#include "solver/scene/geometry.h"
 #include "solver/scene/scene.h"
 
 namespace leaflux {
+
+// Counts that multiply the work a scene makes, capped before any is done. Bands are capped
+// at kMaxBands.
+struct SceneLimits {
+    std::size_t maxSuns = 4096;        // suns of a scene, sun period steps included, or of a cycle
+    std::size_t maxNodes = 1'000'000;  // nodes of a scene (a session's, after any cycle)
+    // The geometry may span at most this many periodic tiles in x and in y: a ray crosses
+    // a tile at each step, so a tile much smaller than the plants multiplies every ray.
+    double maxTilesSpanned = 8.0;
+};
+
+// A request over a limit (SceneLimits, kMaxBands, a daemon's options); `Field()` names what.
+class TooLarge : public std::runtime_error {
+  public:
+    TooLarge(std::string field, const std::string& message)
+        : std::runtime_error(message), field_(std::move(field)) {}
+    const std::string& Field() const { return field_; }
+
+  private:
+    std::string field_;
+};
+
+// Throws TooLarge when the geometry of `flat` spans more than limits.maxTilesSpanned of
+// `scene`'s periodic tiles in x or y.
+void CheckPeriodicTile(const Scene& scene, const FlatScene& flat, const SceneLimits& limits);
 
 // Shared meshes by name (Scene.meshes), which later organs may reference.
 using MeshLibrary = std::map<std::string, std::shared_ptr<const Mesh>>;
@@ -25,10 +53,11 @@ Node NodeFromProto(const v1::Node& node, const MeshLibrary& meshes);
 // A sun for `scene`'s bands; `field` names it in errors.
 Sun SunFromProto(const Scene& scene, const v1::Sun& sun, const std::string& field);
 
-// `baseDirectory` resolves relative import paths (the scene file's folder); `options` say
-// what imports do with geometry that carries no light.
+// `baseDirectory` resolves relative import paths (the scene file's folder). Counts over
+// `limits` throw TooLarge before anything is read; `options` say what imports do with
+// geometry that carries no light.
 Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
-                const ImportOptions& options = {});
+                const SceneLimits& limits = {}, const ImportOptions& options = {});
 
 // Shared meshes stay shared: each distinct mesh is written once in `meshes`.
 v1::Scene ToProto(const Scene& scene);

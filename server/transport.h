@@ -4,7 +4,9 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <zmq.hpp>
@@ -28,11 +30,26 @@ struct CurveKeyPair {
 // file cannot be read or holds no such key.
 std::optional<std::string> ReadCurveKey(const std::string& path);
 
+// Whether an endpoint stays on this machine: tcp:// on 127.0.0.0/8, localhost or [::1],
+// ipc:// and inproc://.
+bool IsLoopback(const std::string& endpoint);
+// Why `endpoint` cannot be bound or connected to as written ("" when it can): a missing
+// transport ("127.0.0.1:5555" for tcp://127.0.0.1:5555), an unknown one.
+std::string EndpointProblem(const std::string& endpoint);
+
+// A message refused for its size: what the transport saw of it.
+struct OversizedMessage {
+    std::size_t bytes = 0, frames = 0;
+    std::string head;  // the first bytes of its last frame (the payload), at most 64
+};
+
 class RouterServer {
   public:
-    // Binds `endpoint` (e.g. tcp://127.0.0.1:5555, tcp://127.0.0.1:* for any port).
+    // Binds `endpoint` (e.g. tcp://127.0.0.1:5555, tcp://127.0.0.1:* for any port); throws
+    // std::runtime_error naming the endpoint when it cannot.
     RouterServer(zmq::context_t& context, const std::string& endpoint, TransportLimits limits = {},
                  const std::string& curveSecretKey = "");
+    ~RouterServer();
 
     // The endpoint actually bound (with the port chosen for a "*").
     std::string Endpoint() const;
@@ -40,20 +57,35 @@ class RouterServer {
     // Called once per message, from any thread, with its reply.
     using Respond = std::function<void(std::string reply)>;
     using Dispatch = std::function<void(std::string payload, Respond respond)>;
+    using TooLarge = std::function<std::string(const OversizedMessage& message)>;
 
-    // Serves until `stop` is set (checked every 100 ms) or, after a reply has been sent,
-    // `stopAfterReply` says so. `dispatch` may answer later from another thread; the socket
-    // itself is only ever used by the thread that serves. `tooLarge` makes the reply to a
-    // message over the limits.
-    void Serve(const Dispatch& dispatch, const std::function<std::string()>& tooLarge,
-               const std::function<bool()>& stopAfterReply, const std::atomic<bool>& stop);
+    // Serves until `stop` says so (asked at least every 100 ms) or, after a reply has been
+    // sent, `stopAfterReply` says so. `dispatch` may answer later from another thread; the
+    // socket itself is only ever used by the thread that serves. `tooLarge` makes the
+    // reply to a message over the limits. May be called again: replies made in between
+    // are sent then.
+    void Serve(const Dispatch& dispatch, const TooLarge& tooLarge,
+               const std::function<bool()>& stopAfterReply, const std::function<bool()>& stop);
+    void Serve(const Dispatch& dispatch, const TooLarge& tooLarge,
+               const std::function<bool()>& stopAfterReply, const std::atomic<bool>& stop) {
+        Serve(dispatch, tooLarge, stopAfterReply, [&stop] { return stop.load(); });
+    }
+
+    // Sends the replies made since the last Serve, then closes the socket, giving ZeroMQ
+    // up to `linger` to deliver them; replies made afterwards are dropped.
+    void Close(std::chrono::milliseconds linger);
 
     // A Dispatch that answers at once with `handle`.
     static Dispatch Synchronous(std::function<std::string(const std::string&)> handle);
 
   private:
+    struct Outbox;
+    void SendReady();
+
     zmq::context_t& context_;
     zmq::socket_t socket_;
+    zmq::socket_t wake_;  // the outbox's wake-up byte arrives here
+    std::shared_ptr<Outbox> outbox_;
     TransportLimits limits_;
 };
 
@@ -65,6 +97,9 @@ class ClientConnection {
                      const std::string& curveServerKey = "");
     // Sends `request`; false when no reply came within `timeoutMs`.
     bool Call(const std::string& request, std::string& reply, int timeoutMs = 600000);
+    // The two halves of Call, for a caller that reads past replies it does not want.
+    void Send(const std::string& request);
+    bool Receive(std::string& reply, int timeoutMs);
 
   private:
     zmq::socket_t socket_;

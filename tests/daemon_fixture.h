@@ -23,10 +23,8 @@ class DaemonOnLoopback : public ::testing::Test {
         thread_ = std::thread([this] {
             server_->Serve(
                 DaemonDispatch(daemon_, executor_),
-                [] {
-                    std::string out;
-                    ErrorReply(v1::ERROR_CODE_TOO_LARGE, "too large").SerializeToString(&out);
-                    return out;
+                [](const OversizedMessage& m) {
+                    return TooLargeReply(m.bytes, m.frames, m.head, 1 << 20);
                 },
                 [this] { return daemon_.ShutdownRequested(); }, stop_);
         });
@@ -37,7 +35,10 @@ class DaemonOnLoopback : public ::testing::Test {
         thread_.join();
     }
 
-    v1::Reply Call(const v1::Request& request) {
+    // Sends `request`, of the current protocol version unless it says another.
+    v1::Reply Call(v1::Request request) {
+        if (request.version() == v1::PROTOCOL_VERSION_UNSPECIFIED)
+            request.set_version(v1::PROTOCOL_VERSION_CURRENT);
         std::string bytes, reply;
         request.SerializeToString(&bytes);
         EXPECT_TRUE(client_->Call(bytes, reply, 60000));

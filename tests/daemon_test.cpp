@@ -32,6 +32,7 @@ v1::Node Leaf(std::uint64_t id, std::uint64_t parent, double x, double z = 1.0) 
 
 v1::Request OpenRequest() {
     v1::Request request;
+    request.set_version(v1::PROTOCOL_VERSION_CURRENT);
     v1::OpenSession* open = request.mutable_open_session();
     v1::Scene* scene = open->mutable_scene();
     scene->add_bands()->set_name("PAR");
@@ -53,6 +54,7 @@ v1::Request OpenRequest() {
 
 v1::Request CycleRequest(const std::string& session, std::int64_t number) {
     v1::Request request;
+    request.set_version(v1::PROTOCOL_VERSION_CURRENT);
     request.set_request_id(static_cast<std::uint64_t>(number) + 100);
     v1::Cycle* cycle = request.mutable_cycle();
     cycle->set_session(session);
@@ -643,6 +645,7 @@ TEST(DaemonCycles, AnUnchangedCycleGetsTheLastLightWithoutSolving) {
     EXPECT_FALSE(fifth.cycle().statistics().reused());
     EXPECT_EQ(fifth.cycle().organs_size(), 2);
     v1::Request status;
+    status.set_version(v1::PROTOCOL_VERSION_CURRENT);
     status.mutable_status()->set_session(session);
     EXPECT_EQ(daemon.Handle(status).status().sessions(0).cycles(), 5);
 }
@@ -672,6 +675,7 @@ TEST(DaemonBands, OnlyTheRequestedBandsAreSolvedAndSent) {
     const double full = all.cycle().organs(1).bands(1).irradiance_upper_wm2();
     EXPECT_NEAR(nirOnly.cycle().organs(1).bands(0).irradiance_upper_wm2(), full, 0.05 * full);
     one.mutable_cycle()->mutable_outputs()->add_bands("NIR");
+    one.mutable_cycle()->set_number(3);
     EXPECT_EQ(daemon.Handle(one).error().code(), v1::ERROR_CODE_ALREADY_EXISTS);
 }
 
@@ -705,7 +709,9 @@ TEST(DaemonOutputs, LightVectorsOnlyWhenAsked) {
 // --solver-threads caps the cores of every solve; a session asking fewer gets fewer.
 TEST(DaemonThreads, SolvesUseAtMostTheDaemonsSolverThreads) {
     for (const auto& [limit, asked, used] : {std::tuple{1, 0, 1}, {1, 2, 1}, {2, 1, 1}}) {
-        Daemon daemon(DaemonLimits{.solverThreads = limit});
+        DaemonLimits limits;
+        limits.solverThreads = limit;
+        Daemon daemon(limits);
         v1::Request open = OpenRequest();
         open.mutable_open_session()->mutable_settings()->set_threads(asked);
         const std::string session = daemon.Handle(open).opened().session();
@@ -727,9 +733,10 @@ TEST(DaemonCurve, AnswersOnlyClientsThatKnowItsKey) {
     std::thread thread([&] {
         server.Serve(
             RouterServer::Synchronous([&](const std::string& r) { return daemon.Handle(r); }),
-            [] { return std::string(); }, [] { return false; }, stop);
+            [](const OversizedMessage&) { return std::string(); }, [] { return false; }, stop);
     });
     v1::Request status;
+    status.set_version(v1::PROTOCOL_VERSION_CURRENT);
     status.mutable_status();
     std::string bytes, reply;
     status.SerializeToString(&bytes);
@@ -762,6 +769,7 @@ TEST(DaemonRestart, ClientResyncsAndContinuesWithIdenticalResults) {
     ASSERT_TRUE(lost.has_error());
     EXPECT_EQ(lost.error().code(), v1::ERROR_CODE_UNKNOWN_SESSION);
     v1::Request resync;
+    resync.set_version(v1::PROTOCOL_VERSION_CURRENT);
     resync.mutable_resync()->set_session(session);
     *resync.mutable_resync()->mutable_scene() = open.open_session().scene();
     *resync.mutable_resync()->mutable_settings() = open.open_session().settings();

@@ -297,6 +297,15 @@ void Scene::Validate() const {
         Require(!surface.name.empty(), ErrorCode::kInvalidArgument,
                 "environment[" + std::to_string(i) + "].name", "is empty");
         RequireOptics(*this, surface.opticsId, field + ".optics", {});
+        // Environment surfaces are opaque (the schema's BandOptics): no light through them.
+        const Optics& opaque = optics[OpticsIndex(surface.opticsId)];
+        for (std::size_t b = 0; b < opaque.bands.size(); ++b) {
+            Require(
+                opaque.bands[b].tauUpperToLower == 0.0 && opaque.bands[b].tauLowerToUpper == 0.0,
+                ErrorCode::kInvalidArgument, field + ".optics",
+                "an environment surface is opaque: optics '" + surface.opticsId +
+                    "' must have tau_upper = tau_lower = 0 (band " + bands[b].name + ")");
+        }
         ValidateMesh(surface.mesh.get(), glm::dmat4(1.0), field + ".mesh", std::nullopt);
         Require(names.insert(surface.name).second, ErrorCode::kAlreadyExists, field + ".name",
                 "the name is used twice");

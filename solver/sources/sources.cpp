@@ -7,6 +7,7 @@
 
 #include "solver/util/check.h"
 #include "solver/util/directions.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 namespace {
@@ -145,7 +146,15 @@ std::vector<Sun> SunPositionsOverPeriod(double latitudeDeg, int dayOfYear, doubl
                                         double endH, double stepH,
                                         const std::vector<double>& normalIrradianceWm2) {
     std::vector<Sun> suns;
-    const int steps = static_cast<int>(std::ceil((endH - startH) / stepH - 1e-9));
+    // Callers cap the steps (the daemon at --max-suns); this cap keeps the count an int
+    // (1e-9 h steps would overflow it and silently make no sun).
+    constexpr double kMaxSteps = 1e7;
+    const double count = std::ceil((endH - startH) / stepH - 1e-9);
+    if (!(count >= 0.0 && count <= kMaxSteps)) {
+        throw InputError(ErrorCode::kInvalidArgument, "step_h",
+                         "makes more than 10^7 sun positions (or none)");
+    }
+    const int steps = static_cast<int>(count);
     for (int i = 0; i < steps; ++i) {
         const double from = startH + i * stepH, to = std::min(endH, from + stepH);
         const SolarAngles angles = SolarPosition(latitudeDeg, dayOfYear, 0.5 * (from + to));

@@ -29,8 +29,8 @@ class Loopback {
     Loopback() : server_(context_, "tcp://127.0.0.1:*") {
         thread_ = std::thread([this] {
             server_.Serve(
-                DaemonDispatch(daemon_, executor_), [] { return std::string(); },
-                [] { return false; }, stop_);
+                DaemonDispatch(daemon_, executor_),
+                [](const OversizedMessage&) { return std::string(); }, [] { return false; }, stop_);
         });
         client_ = std::make_unique<ClientConnection>(context_, server_.Endpoint());
     }
@@ -38,7 +38,8 @@ class Loopback {
         stop_ = true;
         thread_.join();
     }
-    v1::Reply Call(const v1::Request& request) {
+    v1::Reply Call(v1::Request request) {
+        request.set_version(v1::PROTOCOL_VERSION_CURRENT);
         std::string bytes, reply;
         request.SerializeToString(&bytes);
         client_->Call(bytes, reply);

@@ -12,8 +12,11 @@ namespace {
 leaflux::Daemon& FuzzedDaemon() {
     static leaflux::Daemon* daemon = [] {
         auto* d = new leaflux::Daemon();
+        // Resynced under a fixed id (an opened one is random), so that inputs can name it.
         leaflux::v1::Request open;
-        leaflux::v1::Scene* scene = open.mutable_open_session()->mutable_scene();
+        open.set_version(leaflux::v1::PROTOCOL_VERSION_CURRENT);
+        open.mutable_resync()->set_session("00000000000000000000000000000001");
+        leaflux::v1::Scene* scene = open.mutable_resync()->mutable_scene();
         scene->add_bands()->set_name("PAR");
         leaflux::v1::Optics* optics = scene->add_optics();
         optics->set_id("leaf");
@@ -23,7 +26,7 @@ leaflux::Daemon& FuzzedDaemon() {
         leaflux::v1::Sun* sun = scene->add_suns();
         sun->mutable_direction()->set_z(1.0);
         (*sun->mutable_normal_irradiance())["PAR"] = 1000.0;
-        d->Handle(open);  // session "s1"
+        d->Handle(open);
         return d;
     }();
     return *daemon;
