@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "server/transport.h"
+#include "solver/scene/scene.h"
 #include "tests/daemon_process.h"
 #include "tests/daemon_requests.h"
 
@@ -333,8 +334,8 @@ std::vector<Hostile> Table() {
             c.mutable_outputs()->add_bands("PAR");
         }),
         E::ERROR_CODE_ALREADY_EXISTS, "outputs.bands[PAR]");
-    add("9 bands asked", VictimCycle([](v1::Cycle& c) {
-            for (int i = 0; i < 9; ++i) c.mutable_outputs()->add_bands("PAR");
+    add("one band more than a session may declare, asked", VictimCycle([](v1::Cycle& c) {
+            for (int i = 0; i <= kMaxBands; ++i) c.mutable_outputs()->add_bands("PAR");
         }),
         E::ERROR_CODE_TOO_LARGE, "outputs.bands");
     add("100000 bands asked", VictimCycle([](v1::Cycle& c) {
@@ -355,8 +356,8 @@ std::vector<Hostile> Table() {
         E::ERROR_CODE_ALREADY_EXISTS, "bands[PAR]");
     add("a band without a name", Open([](v1::Scene& s, v1::SolverSettings&) { s.add_bands(); }),
         E::ERROR_CODE_NOT_FOUND, "optics[leaf].bands");
-    add("9 bands", Open([](v1::Scene& s, v1::SolverSettings&) {
-            for (int i = 0; i < 8; ++i) s.add_bands()->set_name("b" + std::to_string(i));
+    add("one band more than a session may declare", Open([](v1::Scene& s, v1::SolverSettings&) {
+            for (int i = 0; i < kMaxBands; ++i) s.add_bands()->set_name("b" + std::to_string(i));
         }),
         E::ERROR_CODE_TOO_LARGE, "bands");
     add("100000 bands", Open([](v1::Scene& s, v1::SolverSettings&) {
