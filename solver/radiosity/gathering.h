@@ -38,10 +38,9 @@ void Gather(const NodeModel& model, const Field& field, const Links& links,
 // returns the largest change over the largest radiosity scattered (emission left out).
 double UpdateRadiosity(const Hierarchy& hierarchy, const std::vector<std::uint32_t>& leaves,
                        const ReceiverOptics& optics, LeafLight& leafLight, Field& field);
-// Adds `factor` times the last change to every leaf patch's radiosity, the factor cut so
-// that none goes below zero; returns the factor taken.
-double Extrapolate(const std::vector<std::uint32_t>& leaves, const LeafLight& leafLight,
-                   double factor, Field& field);
+// Adds `factor` times the last change to every leaf patch's radiosity, none below zero.
+void Extrapolate(const std::vector<std::uint32_t>& leaves, const LeafLight& leafLight,
+                 double factor, Field& field);
 
 // Jacobi iteration converges like λᵏ, λ the spectral radius of the transport (≈ ρ + τ of
 // the leaves in a dense canopy or a closed room): at λ = 0.999 thousands of sweeps. The
