@@ -285,30 +285,6 @@ void PushPull::PushDown(const Links& links, const Gathered& gathered, const Sour
     DescendAll(static_cast<std::size_t>(bins) * channels, holds, add, top, aboveBins_);
 }
 
-bool PushPull::HoldsBins(std::uint32_t n, const Links& links) const {
-    return (!model_.Planar(n) && !links.node[n].empty()) || exposure_.Exposed(n);
-}
-
-void PushPull::AddBins(std::uint32_t n, const Links& links, const Gathered& gathered,
-                       std::vector<double>& sum) const {
-    const int bins = model_.BinCount(), channels = model_.ChannelSet().Count();
-    if (exposure_.Exposed(n)) {
-        const float* share = exposure_.Share(n);
-        for (int d = 0; d < bins; ++d) {
-            for (int k = 0; k < channels; ++k)
-                sum[d * channels + k] *= static_cast<double>(share[d]);
-        }
-    }
-    if (model_.Planar(n) || links.node[n].empty()) return;
-    const double* in = gathered.bins[model_.Slot(n)];
-    for (int i = 0; i < bins * channels; ++i) sum[i] += in[i];
-}
-
-void PushPull::AddSources(std::uint32_t n, const Links& links,
-                          std::vector<double>& visibility) const {
-    for (const SourceLink& link : links.source[n]) visibility[link.source] += link.visibility;
-}
-
 std::vector<double> PushPull::BinsAbove(std::uint32_t n, const Links& links,
                                         const Gathered& gathered) const {
     std::vector<std::uint32_t> chain;

@@ -59,11 +59,29 @@ class PushPull {
         std::deque<std::vector<double>> levels;
     };
     void PullNode(Field& field, std::uint32_t n) const;
-    // Whether node n holds cluster light to hand down, and adding it to a sum of bins.
-    bool HoldsBins(std::uint32_t n, const Links& links) const;
+    // Whether node n holds cluster light to hand down, and adding it to a sum of bins (its
+    // share by exposure of what came from above, and what it gathered): inline, for every
+    // sweep hands every node's light down through them.
+    bool HoldsBins(std::uint32_t n, const Links& links) const {
+        return (!model_.Planar(n) && !links.node[n].empty()) || exposure_.Exposed(n);
+    }
     void AddBins(std::uint32_t n, const Links& links, const Gathered& gathered,
-                 std::vector<double>& sum) const;
-    void AddSources(std::uint32_t n, const Links& links, std::vector<double>& visibility) const;
+                 std::vector<double>& sum) const {
+        const int bins = model_.BinCount(), channels = model_.ChannelSet().Count();
+        if (exposure_.Exposed(n)) {
+            const float* share = exposure_.Share(n);
+            for (int d = 0; d < bins; ++d) {
+                for (int k = 0; k < channels; ++k)
+                    sum[d * channels + k] *= static_cast<double>(share[d]);
+            }
+        }
+        if (model_.Planar(n) || links.node[n].empty()) return;
+        const double* in = gathered.bins[model_.Slot(n)];
+        for (int i = 0; i < bins * channels; ++i) sum[i] += in[i];
+    }
+    void AddSources(std::uint32_t n, const Links& links, std::vector<double>& visibility) const {
+        for (const SourceLink& link : links.source[n]) visibility[link.source] += link.visibility;
+    }
     // Handing light down to the leaf patches. Descend visits the top patches under `start`
     // (the first patch on each way down, or `start` itself) and the closed instances with
     // the sum of what their
