@@ -24,6 +24,7 @@
 #include "solver/radiosity/traversal.h"
 #include "solver/radiosity/visibility.h"
 #include "solver/util/check.h"
+#include "solver/util/error.h"
 
 namespace leaflux {
 namespace {
@@ -357,7 +358,9 @@ void SceneSolve::Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock)
 
 Solution SceneSolve::RunLocal(NodeId root) {
     const std::uint32_t b = hierarchy_.NodeOf(root);
-    LEAFLUX_CHECK(b != kNoNode && refiner_ && hierarchy_.Closed().empty());
+    if (b == kNoNode)
+        throw InputError(ErrorCode::kNotFound, "root", "names no structure with organs", root);
+    LEAFLUX_CHECK(refiner_ && hierarchy_.Closed().empty());
     const ResourceClock clock;
     Solution solution;
     solution.light.assign(flat_.receivers.size(), std::vector<BandLight>(channels_.bands));

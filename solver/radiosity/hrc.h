@@ -33,8 +33,9 @@
 // runs and that other drivers reuse: hierarchy (cluster creation), node_model (what each node
 // answers), quadrature and estimate (form factors, transfers, geometric error), visibility,
 // exposure, refinement (linking, judging, splitting, judging again), traversal and push_pull,
-// gathering (sweeps and convergence), outputs and link_audit; channels and light_state hold
-// the per-node light of a run-time number of channels (bands × beams).
+// gathering (sweeps and convergence), outputs and link_audit, closed_node and
+// closed_scattering (closed instances); channels and light_state hold the per-node light of
+// a run-time number of channels (bands × beams).
 #pragma once
 
 #include <cstdint>
