@@ -199,18 +199,24 @@ class SceneSolve {
 
 void SceneSolve::Index() {
     traversal_.Index(hierarchy_, activeRoot_, *active_);
+    // At the cost of the nodes under the root. Gathering rewrites only nodes with links: a
+    // node whose links refinement moved to its children must hand down nothing.
     const std::size_t size = hierarchy_.Size();
-    // Gathering rewrites only nodes with links: a node whose links refinement moved to
-    // its children must hand down nothing.
-    gathered_.bins.Assign(model_.SlotCount());
-    gathered_.sides.Assign(size);
-    gathered_.integral.Assign(size);
-    gathered_.moment.Assign(size);
+    gathered_.bins.Resize(model_.SlotCount());
+    gathered_.sides.Resize(size);
+    gathered_.integral.Resize(size);
+    gathered_.moment.Resize(size);
     leafLight_.Resize(size);
-    leafLight_.emission.Assign(size);
-    for (std::uint32_t n = 0; n < size; ++n) {
+    leafLight_.emission.Resize(size);
+    for (std::uint32_t n : traversal_.PreOrder()) {
+        gathered_.sides.ClearRow(n);
+        gathered_.integral.ClearRow(n);
+        gathered_.moment.ClearRow(n);
         const HrcNode& node = hierarchy_[n];
-        if (!node.patch) continue;
+        if (!node.patch) {
+            if (model_.Slot(n) != kNoNode) gathered_.bins.ClearRow(model_.Slot(n));
+            continue;
+        }
         const Receiver& receiver = flat_.receivers[node.receiver];
         if (receiver.kind != ReceiverKind::kEmitter) continue;
         const auto& exitance = scene_.sources.emitters[receiver.emitter].exitanceWm2;

@@ -14,7 +14,7 @@ void Traversal::Index(const Hierarchy& hierarchy, std::uint32_t root, const Link
     }
     Share(hierarchy);
     receivers_.clear();
-    for (std::uint32_t n = 0; n < links.node.size(); ++n) {
+    for (std::uint32_t n : preOrder_) {
         if (!links.node[n].empty()) receivers_.push_back(n);
     }
 }

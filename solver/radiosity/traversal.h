@@ -15,7 +15,8 @@ namespace leaflux {
 
 class Traversal {
   public:
-    // Indexes the hierarchy under `root` as it stands, with the links it holds.
+    // Indexes the hierarchy under `root` as it stands, with the links it holds: at the cost
+    // of the nodes under it, whatever the hierarchy's size (a local problem's few).
     void Index(const Hierarchy& hierarchy, std::uint32_t root, const Links& links);
 
     std::uint32_t Root() const { return root_; }
