@@ -52,7 +52,6 @@ struct SourceLight {
     SideTable sides;
     Table<double> integral;
     Table<glm::dvec3> moment;
-    bool Pushed() const { return sides.Rows() > 0; }
 };
 
 struct LeafLight {

@@ -45,7 +45,6 @@ class NodeModel {
     bool Inner(std::uint32_t triangle, int side) const {
         return triangle != kNoTriangle && inner_[triangle] >> side & 1;
     }
-    bool AnyInner(std::uint32_t triangle) const { return inner_[triangle] != 0; }
     // How much a receiving point of normal n on a triangle takes of light from ω: |n · ω|,
     // but nothing on the inner side of a solid.
     // A point in a closed instance's box takes light from every direction alike: 1.
