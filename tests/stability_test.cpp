@@ -290,6 +290,19 @@ TEST_P(Stability, SunHalfADegreeAboveTheHorizon) {
     ExpectCloseToReference(Prepared(), solution);
 }
 
+// The brightest sun the boundary accepts gives finite light, in proportion.
+TEST_P(Stability, TheBrightestSunAcceptedGivesFiniteLight) {
+    Scene scene = TwoLitLeaves(0.02, glm::dvec3(0.0));
+    scene.sources.suns = {SunAt(60, 90, kMaxIrradianceWm2)};
+    const Solution solution = Run(scene);
+    ExpectFiniteLight(solution);
+    for (const EnergyBalance& balance : solution.balance) {
+        EXPECT_TRUE(std::isfinite(balance.incidentW) && std::isfinite(balance.absorbedW) &&
+                    std::isfinite(balance.escapedW));
+        EXPECT_GT(balance.incidentW, 0.0);
+    }
+}
+
 // A sun exactly on a vertex of the direction sets (the zenith, and a vertex of the 34-
 // direction set) lights the canopy as a sun a hair's breadth away does: no direction
 // falls between the faces of a set.

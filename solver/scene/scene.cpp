@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <set>
 #include <type_traits>
 #include <unordered_map>
@@ -34,9 +35,14 @@ void RequirePerBand(const Scene& scene, const std::vector<double>& values,
             "needs one value per band (" + std::to_string(scene.bands.size()) + "), got " +
                 std::to_string(values.size()));
     for (std::size_t b = 0; b < values.size(); ++b) {
+        char got[32];
+        std::snprintf(got, sizeof got, "%g", values[b]);
         Require(std::isfinite(values[b]) && values[b] >= 0.0, ErrorCode::kInvalidArgument,
                 field + "[" + scene.bands[b].name + "]",
-                "must be finite and non-negative, got " + std::to_string(values[b]));
+                std::string("must be finite and non-negative, got ") + got);
+        Require(values[b] <= kMaxIrradianceWm2, ErrorCode::kInvalidArgument,
+                field + "[" + scene.bands[b].name + "]",
+                std::string("is out of range: at most 1e12 W/m², got ") + got);
     }
 }
 

@@ -48,6 +48,11 @@ struct Mesh {
 // single-precision ray tracing (Embree) can no longer tell leaves apart.
 inline constexpr double kMaxCoordinateM = 1e6;
 
+// Irradiances and exitances (W/m²) beyond this are out of range: a million times the sun,
+// and far enough below the largest double that every sum of powers over a scene of
+// coordinates within kMaxCoordinateM stays finite (a sun of 1e308 W/m² made NaN of it).
+inline constexpr double kMaxIrradianceWm2 = 1e12;
+
 // Whether a triangle, in coordinates within kMaxCoordinateM, has an area light can land on:
 // its area does not vanish against its longest edge (the sine of its largest angle's
 // complement is at least 1e-9, a sliver Embree would lose in float). The one test of
