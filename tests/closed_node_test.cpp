@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "solver/radiosity/hrc.h"
@@ -94,6 +95,8 @@ TEST(ClosedNode, AnIsotropicScattererLightsAReceiverBesideItAsItsClosedForm) {
     // The link carries the box's light as a point transfer with its spread's second-order
     // correction; its geometric error, ((r_R + r_S) / d)², bounds what is left.
     const double bound = std::pow((std::sqrt(0.02) + std::sqrt(0.75)) / 10.0, 2.0);
+    std::printf("plate beside: %.5f W/m², by quadrature %.5f W/m², bound %.2f %%\n",
+                s.light[0][0].irradianceUpperWm2, expected, 100.0 * bound);
     EXPECT_NEAR(s.light[0][0].irradianceUpperWm2, expected, bound * expected);
     EXPECT_NEAR(s.light[0][0].irradianceLowerWm2, 0.0, 1e-12);
     // Below the box, its scattered light comes on top of the sun it lets through.

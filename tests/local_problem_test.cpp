@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -101,6 +102,8 @@ Difference Compare(const Scene& scene, const PreparedScene& prepared, NodeId roo
 // generated trees, README): a thousandth of the mean organ's light bounds it per organ, a
 // ten-thousandth in RMS.
 void ExpectSameLight(const Difference& d, int atLeast) {
+    std::printf("%d organs, mean %.3f W/m²: local against whole %.5f %% worst, %.6f %% RMS\n",
+                d.organs, d.mean, 100.0 * d.worst / d.mean, 100.0 * d.rms / d.mean);
     EXPECT_GE(d.organs, atLeast);
     EXPECT_LT(d.worst, 1e-3 * d.mean) << "mean " << d.mean;
     EXPECT_LT(d.rms, 1e-4 * d.mean) << "mean " << d.mean;
