@@ -591,8 +591,7 @@ Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScen
             solution.light[r].insert(solution.light[r].end(), part.light[r].begin(),
                                      part.light[r].end());
         }
-        solution.balance.insert(solution.balance.end(), part.balance.begin(),
-                                part.balance.end());
+        solution.balance.insert(solution.balance.end(), part.balance.begin(), part.balance.end());
         solution.stats.rays += part.stats.rays;
         solution.stats.threads = part.stats.threads;
     }
