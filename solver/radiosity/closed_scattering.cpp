@@ -24,6 +24,9 @@ double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource
         const double* fromSources = arrived.sources[c];
         std::vector<glm::dvec3> local(bins);
         for (int d = 0; d < bins; ++d) local[d] = closed.ToInstance(directions.Direction(d));
+        std::vector<glm::dvec3> towardSources(sources.size());
+        for (std::size_t s = 0; s < sources.size(); ++s)
+            towardSources[s] = closed.ToInstance(sources[s].toward);
         std::vector<double> power(count, 0.0);
         for (int o = 0; o < bins; ++o) {
             for (int k = 0; k < count; ++k) {
@@ -35,9 +38,7 @@ double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource
                 }
                 for (std::size_t s = 0; s < sources.size(); ++s) {
                     const double e = fromSources[s] * sources[s].normalIrradiance[k];
-                    if (e != 0.0)
-                        intensity += e * contents.Phase(band, closed.ToInstance(sources[s].toward),
-                                                        local[o]);
+                    if (e != 0.0) intensity += e * contents.Phase(band, towardSources[s], local[o]);
                 }
                 change[c] = std::max(change[c], std::abs(intensity - out[o * count + k]));
                 largest[c] = std::max(largest[c], intensity);

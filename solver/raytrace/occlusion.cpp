@@ -16,12 +16,12 @@ struct ProxyQuery {
     double tFar;
     std::span<const std::uint32_t> exclude;
     double transmittance = 1.0;
-    std::vector<std::uint32_t> counted;
+    std::vector<std::uint32_t>* counted = nullptr;  // the thread's, reused from ray to ray
 
     // Multiplies in box `id` once; false when nothing passes any more.
     bool Cross(std::uint32_t id) {
         if (std::find(exclude.begin(), exclude.end(), id) != exclude.end()) return true;
-        if (std::find(counted.begin(), counted.end(), id) != counted.end()) return true;
+        if (std::find(counted->begin(), counted->end(), id) != counted->end()) return true;
         const Occlusion::Box& box = occlusion->boxes_[id];
         const glm::dvec3 o = glm::dvec3(box.instanceFromScene * glm::dvec4(origin, 1.0));
         const glm::dvec3 d = glm::dmat3(box.instanceFromScene) * direction;
@@ -40,7 +40,7 @@ struct ProxyQuery {
         }
         const double from = std::max(enter, 0.0), to = std::min(exit, tFar);
         if (!(to > from) || !(exit > enter)) return true;
-        counted.push_back(id);
+        counted->push_back(id);
         const double tau =
             std::clamp(occlusion->proxies_[id].transmittance(glm::normalize(d)), 0.0, 1.0);
         const double fraction = std::min((to - from) / (exit - enter), 1.0);
@@ -121,7 +121,10 @@ Occlusion::~Occlusion() {
 
 double Occlusion::ThroughBoxes(const RayStart& start, const glm::dvec3& direction,
                                double maxDistance, std::span<const std::uint32_t> exclude) const {
+    thread_local std::vector<std::uint32_t> counted;
+    counted.clear();
     ProxyQuery query;
+    query.counted = &counted;
     rtcInitIntersectContext(&query.context);
     query.occlusion = this;
     query.origin = start.origin;
