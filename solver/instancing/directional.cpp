@@ -11,16 +11,18 @@ constexpr double kFourPi = 4.0 * std::numbers::pi;
 
 void CheckLevel(int level) {
     if (level < 0 || level > 4)
-        throw std::invalid_argument("direction level " + std::to_string(level) +
-                                    " is not in 0..4");
+        throw std::invalid_argument("direction level " + std::to_string(level) + " is not in 0..4");
 }
 
 std::size_t PhaseValueCount(PhaseKind kind, int level, int bands) {
     const std::size_t n = DirectionSet::OfLevel(level).Size();
     switch (kind) {
-        case PhaseKind::kConstant: return static_cast<std::size_t>(bands);
-        case PhaseKind::kMonoDirectional: return n * bands;
-        case PhaseKind::kBiDirectional: return n * n * bands;
+        case PhaseKind::kConstant:
+            return static_cast<std::size_t>(bands);
+        case PhaseKind::kMonoDirectional:
+            return n * bands;
+        case PhaseKind::kBiDirectional:
+            return n * n * bands;
     }
     throw std::invalid_argument("unknown phase function kind");
 }
@@ -49,22 +51,27 @@ SphereFunction SphereFunction::FromValues(int level, int channels, std::vector<f
 double SphereFunction::Value(const glm::dvec3& direction, int channel) const {
     const DirectionSet::Interpolation at = Directions().Locate(direction);
     double value = 0.0;
-    for (int k = 0; k < 3; ++k) value += at.weight[k] * static_cast<double>(At(at.vertex[k], channel));
+    for (int k = 0; k < 3; ++k)
+        value += at.weight[k] * static_cast<double>(At(at.vertex[k], channel));
     return value;
 }
 
 double SphereFunction::Integral(int channel) const {
     const DirectionSet& set = Directions();
     double total = 0.0;
-    for (int i = 0; i < set.Size(); ++i) total += static_cast<double>(At(i, channel)) * set.HatIntegralSr(i);
+    for (int i = 0; i < set.Size(); ++i)
+        total += static_cast<double>(At(i, channel)) * set.HatIntegralSr(i);
     return total;
 }
 
 const char* PhaseKindName(PhaseKind kind) {
     switch (kind) {
-        case PhaseKind::kConstant: return "constant";
-        case PhaseKind::kMonoDirectional: return "mono";
-        case PhaseKind::kBiDirectional: return "bi";
+        case PhaseKind::kConstant:
+            return "constant";
+        case PhaseKind::kMonoDirectional:
+            return "mono";
+        case PhaseKind::kBiDirectional:
+            return "bi";
     }
     return "unknown";
 }
@@ -117,7 +124,8 @@ double PhaseFunction::Value(int band, const glm::dvec3& towardSource,
 }
 
 double PhaseFunction::ScatteredPower(int band, const glm::dvec3& towardSource) const {
-    if (kind_ != PhaseKind::kBiDirectional) return kFourPi * Value(band, towardSource, towardSource);
+    if (kind_ != PhaseKind::kBiDirectional)
+        return kFourPi * Value(band, towardSource, towardSource);
     const DirectionSet& set = Directions();
     const DirectionSet::Interpolation in = set.Locate(towardSource);
     const std::size_t n = set.Size();
@@ -145,8 +153,7 @@ PhaseFunction PhaseFunction::Reduced(PhaseKind kind) const {
             }
             double sum = 0.0;
             for (int o = 0; o < n; ++o)
-                sum += V((static_cast<std::size_t>(i) * n + o) * bands_ + b) *
-                       set.HatIntegralSr(o);
+                sum += V((static_cast<std::size_t>(i) * n + o) * bands_ + b) * set.HatIntegralSr(o);
             power[i * bands_ + b] = sum;
         }
     }

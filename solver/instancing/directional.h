@@ -48,9 +48,9 @@ class SphereFunction {
 
 // How finely a phase function follows the directions (Soler 2003 §4.2.1).
 enum class PhaseKind : int {
-    kConstant = 0,          // one value per band: scattered evenly, whatever the light's direction
-    kMonoDirectional = 1,   // per incoming direction, scattered evenly in every direction
-    kBiDirectional = 2,     // per incoming and outgoing direction
+    kConstant = 0,         // one value per band: scattered evenly, whatever the light's direction
+    kMonoDirectional = 1,  // per incoming direction, scattered evenly in every direction
+    kBiDirectional = 2,    // per incoming and outgoing direction
 };
 const char* PhaseKindName(PhaseKind kind);  // "constant", "mono", "bi"
 

@@ -28,9 +28,7 @@ class ContentHash {
         return Add(static_cast<std::uint64_t>(text.size()));  // "ab","c" differs from "a","bc"
     }
     template <class T>
-    ContentHash& Add(const T& value)
-        requires std::is_arithmetic_v<T>
-    {
+    ContentHash& Add(const T& value) requires std::is_arithmetic_v<T> {
         return Add(&value, sizeof value);
     }
     template <class T>
