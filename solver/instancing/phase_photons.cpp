@@ -120,7 +120,8 @@ class BeamTracer {
             const int group = p % groups;
             // A photon carries the box's cross-section along its direction: the power of a
             // unit irradiance on the box.
-            const glm::dvec3 along = -incoming_.Sample(i, random);
+            const glm::dvec3 along =
+                options_.hatIncoming ? -incoming_.Sample(i, random) : -set.Direction(i);
             const double area = structure_.ProjectedArea(along);
             entered += area;
             RayStart start{structure_.Entry(along, (p + random.Uniform()) / n, random.Uniform(),

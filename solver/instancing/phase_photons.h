@@ -32,6 +32,9 @@ struct PhotonOptions {
                     // averages over the incoming directions of this level
     int photonsPerBeam = 20000;
     int replicates = 8;  // independent groups per beam, for the standard errors (≥ 2)
+    // Incoming directions drawn over each direction's hat; false: every photon of beam i
+    // comes from direction i itself (as radiosity's beams do, phase_radiosity.h).
+    bool hatIncoming = true;
     std::uint64_t seed = 1;
 };
 

@@ -73,15 +73,38 @@ std::vector<DirectionalSource> BeamsOf(const Scene& scene, SkyDiscretization sky
     return sources;
 }
 
+// Unit parallel beams, one per direction: channels bands × beams, beam k lighting only its
+// own channels, each judged as a scene of its own (kWorstBeam).
+std::vector<DirectionalSource> UnitBeams(const Channels& channels,
+                                         std::span<const glm::dvec3> towardSource) {
+    std::vector<DirectionalSource> sources;
+    for (int beam = 0; beam < channels.beams; ++beam) {
+        DirectionalSource source{glm::normalize(towardSource[beam]),
+                                 std::vector<double>(channels.Count(), 0.0)};
+        for (int b = 0; b < channels.bands; ++b)
+            source.normalIrradiance[beam * channels.bands + b] = 1.0;
+        sources.push_back(std::move(source));
+    }
+    return sources;
+}
+
 class SceneSolve {
   public:
+    // The scene's suns and sky cones, a channel per band.
     SceneSolve(const Scene& scene, const FlatScene& flat, const RayScene& rays,
                const HrcOptions& options, std::span<const ClosedNode> closed)
+        : SceneSolve(scene, flat, rays, options, closed,
+                     {static_cast<int>(scene.bands.size()), 1, ChannelMeasure::kSum},
+                     BeamsOf(scene, options.skyCones)) {}
+    // Given channels and sources (UnitBeams).
+    SceneSolve(const Scene& scene, const FlatScene& flat, const RayScene& rays,
+               const HrcOptions& options, std::span<const ClosedNode> closed,
+               const Channels& channels, std::vector<DirectionalSource> sources)
         : scene_(scene),
           flat_(flat),
           rays_(rays),
           options_(options),
-          channels_{static_cast<int>(scene.bands.size()), 1, ChannelMeasure::kSum},
+          channels_(channels),
           hierarchy_(scene, flat, closed),
           model_(hierarchy_, scene, rays, DirectionSet::OfLevel(options.directionLevel), channels_,
                  options.maxSubdivision),
@@ -90,7 +113,7 @@ class SceneSolve {
           sourceLight_(channels_),
           leafLight_(channels_),
           optics_(scene, flat, channels_),
-          sources_(BeamsOf(scene, options.skyCones)),
+          sources_(std::move(sources)),
           closedLight_(channels_, model_.BinCount(), closed.size(), sources_.size()),
           occlusion_(rays, ProxiesOf(closed)),
           estimator_(model_, field_),
@@ -121,6 +144,8 @@ class SceneSolve {
     // After Run: the subtree under scene node `root` solved again alone, as a local problem
     // (hrc.h, SolveHrcThenLocal).
     Solution RunLocal(NodeId root);
+    // After Run under unit beams: the leaf patches and their radiosity.
+    void Patches(BeamSolution& beams) const;
 
   private:
     void Solve(Solution& solution);
@@ -250,10 +275,13 @@ void SceneSolve::Solve(Solution& solution) {
     for (std::uint32_t n : preOrder)
         std::copy_n(leafLight_.emission[n], channels_.Count(), field_.radiosity(n, kUpper));
     // The power the sources bring in, unoccluded: the scale of every link's error.
+    // Under unit beams each beam is a scene of its own: the scale is the brightest's.
+    const bool perBeam = channels_.measure == ChannelMeasure::kWorstBeam && channels_.beams > 1;
     double totalPower = 0.0;
     for (const DirectionalSource& source : sources_) {
-        const double power = channels_.Measure(source.normalIrradiance.data());
-        totalPower += power * model_.ProjectedArea(hierarchy_.Root(), source.toward);
+        const double power = channels_.Measure(source.normalIrradiance.data()) *
+                             model_.ProjectedArea(hierarchy_.Root(), source.toward);
+        totalPower = perBeam ? std::max(totalPower, power) : totalPower + power;
     }
     for (std::uint32_t n : preOrder) {
         for (int b = 0; b < channels_.Count(); ++b)
@@ -261,7 +289,8 @@ void SceneSolve::Solve(Solution& solution) {
     }
     if (totalPower <= 0.0) return Outputs(solution);
 
-    thresholds_ = {options_.epsilon * totalPower, options_.clusterTolerance, sources_.size()};
+    thresholds_ = {options_.epsilon * totalPower, options_.clusterTolerance,
+                   perBeam ? std::size_t{1} : sources_.size()};
     refiner_.emplace(model_, field_, links_, estimator_, visibility_, sources_, thresholds_,
                      [this](std::uint32_t n) { OnSplit(n); });
     Refiner& refiner = *refiner_;
@@ -429,12 +458,42 @@ void SceneSolve::Outputs(Solution& solution) {
     solution.stats.elements = static_cast<std::int64_t>(hierarchy_.Size());
     solution.stats.refinementDepth = static_cast<int>(
         traversal_.Subtrees().empty() ? 0 : traversal_.Depth(hierarchy_, *active_));
+    if (channels_.beams > 1) return;  // their light is read by Patches
     SolutionSink sink(solution);
     rayCount_ += WriteOutputs(model_, rays_, traversal_.Leaves(), optics_, field_, leafLight_, sink,
                               solution.balance);
 }
 
+void SceneSolve::Patches(BeamSolution& beams) const {
+    beams.channels = channels_;
+    const int width = 2 * channels_.Count();
+    for (std::uint32_t n : traversal_.Leaves()) {
+        const HrcNode& node = hierarchy_[n];
+        if (!node.patch || flat_.receivers[node.receiver].kind != ReceiverKind::kOrgan) continue;
+        beams.patches.push_back({node.a, node.b, node.c, node.normal, node.areaM2, node.triangle});
+        for (int side : {kUpper, kLower}) {
+            const double* b = field_.radiosity(n, side);
+            beams.radiosity.insert(beams.radiosity.end(), b, b + channels_.Count());
+        }
+    }
+    LEAFLUX_CHECK_EQ(beams.radiosity.size(), beams.patches.size() * width);
+}
+
 }  // namespace
+
+BeamSolution SolveBeams(const Scene& scene, const FlatScene& flat, const RayScene& rays,
+                        const HrcOptions& options, std::span<const glm::dvec3> towardSource) {
+    LEAFLUX_CHECK(options.directionLevel >= 0 && options.directionLevel <= 4);
+    LEAFLUX_CHECK(!scene.bands.empty() && !towardSource.empty());
+    const ResourceClock clock;
+    const Channels channels{static_cast<int>(scene.bands.size()),
+                            static_cast<int>(towardSource.size()), ChannelMeasure::kWorstBeam};
+    SceneSolve solver(scene, flat, rays, options, {}, channels, UnitBeams(channels, towardSource));
+    BeamSolution beams;
+    beams.stats = solver.Run(clock).stats;
+    solver.Patches(beams);
+    return beams;
+}
 
 Solution SolveHrc(const Scene& scene, const FlatScene& flat, const RayScene& rays,
                   const HrcOptions& options, std::span<const ClosedNode> closed) {

@@ -41,6 +41,7 @@
 #include <cstdint>
 #include <span>
 
+#include "solver/radiosity/channels.h"
 #include "solver/radiosity/closed_node.h"
 #include "solver/raytrace/raytrace.h"
 #include "solver/results/light.h"
@@ -103,6 +104,29 @@ Solution SolveHrc(const Scene& scene, const FlatScene& flat, const RayScene& ray
 // exchanges refined again from its own emission under the whole solve's threshold. `local`
 // has the structure's receivers' light (the others' are zero); its balance is the
 // structure's.
+// One structure alone under unit parallel beams from each of `towardSource` (unit
+// irradiance normal to each beam), the beams as channels of one solve, for the links do not
+// depend on where the light comes from (Soler 2003 §4.2.3): channel k · bands + b is band b
+// of beam k, and refinement judges each beam as a scene of its own (kWorstBeam). The answer
+// is every leaf patch's radiosity, from which a phase function is read.
+struct BeamPatch {
+    glm::dvec3 a, b, c, normal;  // the flat scene's frame; normal: the upper side
+    double areaM2;
+    std::uint32_t triangle;  // its flat triangle, which rays leaving it ignore
+};
+struct BeamSolution {
+    Channels channels;
+    std::vector<BeamPatch> patches;
+    // Exitance (W/m² per W/m² of beam): [patch][side][channel], side kUpper then kLower.
+    std::vector<double> radiosity;
+    SolveStats stats;
+    const double* Radiosity(std::size_t patch, int side) const {
+        return radiosity.data() + (2 * patch + side) * channels.Count();
+    }
+};
+BeamSolution SolveBeams(const Scene& scene, const FlatScene& flat, const RayScene& rays,
+                        const HrcOptions& options, std::span<const glm::dvec3> towardSource);
+
 struct LocalSolve {
     Solution whole, local;
 };

@@ -1,0 +1,185 @@
+// The cost and accuracy of a structure's functions (Soler 2003 §4.2.2).
+//
+// 1. The time to compute τ and f for trees of 10, 100 and 1,000 leaves at each kind and
+//    resolution: constant, mono-directional (514), bi-directional 34², 130² and 514².
+// 2. The paper's §4.2.2 table on a generated branch: each kind against the bi-directional
+//    514² function, L∞ and L2 of the difference over every pair of the 514 directions (in
+//    % of the largest value of f, pairs weighted by their hats' solid angles), the size and
+//    the time; with the noise floor of each, the RMS of its photons' standard error.
+// Prints both tables and writes CSV.
+// Run: build/release/tests/leaflux_bench_phase [out dir, out/bench] [photons per beam, 20000]
+//      [reference photons per beam, 100000]
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "solver/generate/generator.h"
+#include "solver/instancing/phase_photons.h"
+#include "solver/instancing/structure.h"
+#include "solver/instancing/transmittance.h"
+
+namespace leaflux {
+namespace {
+
+Scene Tree(int leaves, std::uint64_t seed = 1) {
+    Scene scene;
+    scene.bands = {{"PAR"}, {"NIR"}};
+    scene.optics = {{"leaf", {{0.08, 0.06, 0.05, 0.05}, {0.45, 0.4, 0.45, 0.45}}},
+                    {"stem", {{0.1, 0.1, 0.0, 0.0}, {0.3, 0.3, 0.0, 0.0}}}};
+    TreeParameters tree;
+    tree.leafCount = leaves;
+    tree.seed = seed;
+    AddTree(scene, tree, {0, 0, 0});
+    return scene;
+}
+
+struct Kind {
+    const char* name;
+    PhaseKind kind;
+    int level;
+};
+const Kind kKinds[] = {{"constant", PhaseKind::kConstant, 3},
+                       {"mono 514", PhaseKind::kMonoDirectional, 4},
+                       {"bi 34²", PhaseKind::kBiDirectional, 2},
+                       {"bi 130²", PhaseKind::kBiDirectional, 3},
+                       {"bi 514²", PhaseKind::kBiDirectional, 4}};
+
+PhaseEstimate Compute(const StructureAlone& structure, const Kind& kind, int photons) {
+    PhotonOptions options;
+    options.kind = kind.kind;
+    options.level = kind.level;
+    options.photonsPerBeam = photons;
+    return PhaseFromPhotons(structure, options);
+}
+
+void Timing(const std::string& csv, int photons) {
+    std::FILE* out = std::fopen(csv.c_str(), "w");
+    std::fprintf(out, "leaves,triangles,function,directions,rays,seconds,kB\n");
+    std::printf(
+        "\nTime to compute a structure's functions (%d photons a beam, 4096 rays a τ "
+        "direction)\n",
+        photons);
+    std::printf("%7s %9s  %-10s %10s %11s %9s %10s\n", "leaves", "triangles", "function",
+                "directions", "rays", "seconds", "kB");
+    for (int leaves : {10, 100, 1000}) {
+        const Scene scene = Tree(leaves);
+        const StructureAlone tree(scene, scene.nodes.front().id);
+        const auto row = [&](const char* function, int directions, std::int64_t rays,
+                             double seconds, double kB) {
+            std::printf("%7lld %9zu  %-10s %10d %11lld %9.3f %10.3f\n",
+                        static_cast<long long>(tree.LeafCount()), tree.Flat().triangles.size(),
+                        function, directions, static_cast<long long>(rays), seconds, kB);
+            std::fprintf(out, "%lld,%zu,%s,%d,%lld,%.4f,%.3f\n",
+                         static_cast<long long>(tree.LeafCount()), tree.Flat().triangles.size(),
+                         function, directions, static_cast<long long>(rays), seconds, kB);
+        };
+        for (int level : {2, 3, 4}) {
+            const TransmittanceEstimate t = ComputeTransmittance(tree, {level, 4096, 1});
+            row("tau", t.tau.Directions().Size(), t.rays, t.seconds,
+                t.tau.Values().size() * sizeof(float) / 1000.0);
+        }
+        for (const Kind& kind : kKinds) {
+            const PhaseEstimate f = Compute(tree, kind, photons);
+            row(kind.name, DirectionSet::OfLevel(kind.level).Size(), f.rays, f.seconds,
+                f.phase.Bytes() / 1000.0);
+        }
+    }
+    std::fclose(out);
+}
+
+// The axis whose subtree holds the number of leaves nearest `wanted`.
+NodeId BranchNear(const Scene& scene, int wanted) {
+    std::unordered_map<NodeId, NodeId> parent;
+    for (const Node& node : scene.nodes) parent[node.id] = node.parent;
+    std::unordered_map<NodeId, int> leaves;
+    for (const Node& node : scene.nodes) {
+        if (node.type != NodeType::kLeaf) continue;
+        for (NodeId up = node.parent; up != kNoParent; up = parent[up]) ++leaves[up];
+    }
+    NodeId best = kNoParent;
+    for (const Node& node : scene.nodes) {
+        if (node.type != NodeType::kAxis || node.parent == kNoParent) continue;
+        if (best == kNoParent ||
+            std::abs(leaves[node.id] - wanted) < std::abs(leaves[best] - wanted))
+            best = node.id;
+    }
+    return best;
+}
+
+void PaperTable(const std::string& csv, int photons, int referencePhotons) {
+    const Scene scene = Tree(2000, 3);
+    const StructureAlone branch(scene, BranchNear(scene, 150));
+    const DirectionSet& set = DirectionSet::OfLevel(4);
+    const int n = set.Size();
+    const Kind reference = kKinds[4];
+    const PhaseEstimate exact = Compute(branch, reference, referencePhotons);
+    const int band = 1;  // NIR: the most scattered
+    const int bands = exact.phase.Bands();
+    double largest = 0.0, weights = 0.0, noise = 0.0;
+    for (int i = 0; i < n; ++i) {
+        for (int o = 0; o < n; ++o) {
+            const std::size_t k = (static_cast<std::size_t>(i) * n + o) * bands + band;
+            largest = std::max(largest, double(exact.phase.Values()[k]));
+            const double w = set.HatIntegralSr(i) * set.HatIntegralSr(o);
+            weights += w;
+            noise += w * std::pow(double(exact.standardError.Values()[k]), 2);
+        }
+    }
+    std::FILE* out = std::fopen(csv.c_str(), "w");
+    std::fprintf(out, "function,linf_pct,l2_pct,noise_l2_pct,kB,seconds,photons\n");
+    std::printf(
+        "\nThe paper's §4.2.2 table on a generated branch (%s: %lld leaves, %zu "
+        "triangles), NIR band,\nagainst bi-directional 514² of %d photons a beam "
+        "(its noise floor %.2f %% L2, %.1f s)\n",
+        branch.Name().c_str(), static_cast<long long>(branch.LeafCount()),
+        branch.Flat().triangles.size(), referencePhotons,
+        100.0 * std::sqrt(noise / weights) / largest, exact.seconds);
+    std::printf("%-10s %8s %8s %13s %11s %9s\n", "function", "L∞ %", "L2 %", "own noise %",
+                "size kB", "seconds");
+    for (const Kind& kind : kKinds) {
+        const PhaseEstimate f = Compute(branch, kind, photons);
+        double worst = 0.0, sum = 0.0, ownNoise = 0.0;
+        for (int i = 0; i < n; ++i) {
+            for (int o = 0; o < n; ++o) {
+                const std::size_t k = (static_cast<std::size_t>(i) * n + o) * bands + band;
+                const double d = f.phase.Value(band, set.Direction(i), set.Direction(o)) -
+                                 double(exact.phase.Values()[k]);
+                const double w = set.HatIntegralSr(i) * set.HatIntegralSr(o);
+                worst = std::max(worst, std::abs(d));
+                sum += w * d * d;
+                ownNoise +=
+                    w *
+                    std::pow(f.standardError.Value(band, set.Direction(i), set.Direction(o)), 2);
+            }
+        }
+        const double linf = 100.0 * worst / largest,
+                     l2 = 100.0 * std::sqrt(sum / weights) / largest;
+        const double own = 100.0 * std::sqrt(ownNoise / weights) / largest;
+        std::printf("%-10s %8.1f %8.2f %13.2f %11.3f %9.2f\n", kind.name, linf, l2, own,
+                    f.phase.Bytes() / 1000.0, f.seconds);
+        std::fprintf(out, "%s,%.3f,%.4f,%.4f,%.3f,%.3f,%d\n", kind.name, linf, l2, own,
+                     f.phase.Bytes() / 1000.0, f.seconds, photons);
+    }
+    std::fclose(out);
+}
+
+}  // namespace
+}  // namespace leaflux
+
+int main(int argc, char** argv) {
+    spdlog::set_level(spdlog::level::warn);
+    const std::string dir = argc > 1 ? argv[1] : "out/bench";
+    const int photons = argc > 2 ? std::atoi(argv[2]) : 20000;
+    const int referencePhotons = argc > 3 ? std::atoi(argv[3]) : 100000;
+    std::filesystem::create_directories(dir);
+    leaflux::PaperTable(dir + "/phase_table.csv", photons, referencePhotons);
+    leaflux::Timing(dir + "/phase_functions.csv", photons);
+    return 0;
+}
