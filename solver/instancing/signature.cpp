@@ -191,6 +191,18 @@ SceneSignatures ComputeSignatures(const Scene& scene, const InstancingPolicy& po
         ChooseRepresentative(group, result);
         result.groups.push_back(std::move(group));
     }
+    // By type, then by bins in signature order, so a listing reads from small to large
+    // (the strings alone would put "leaves[1001" before "leaves[101").
+    const auto key = [&](const SignatureGroup& group) {
+        const StructureSignature& s = *result.Find(group.members.front());
+        std::vector<int> bins{static_cast<int>(s.type), s.fixed, s.leafBin, s.ageBin};
+        for (const std::size_t a : attributesByName) bins.push_back(s.attributeBins[a]);
+        return bins;
+    };
+    std::sort(result.groups.begin(), result.groups.end(), [&](const auto& a, const auto& b) {
+        const auto ka = key(a), kb = key(b);
+        return ka != kb ? ka < kb : a.signature < b.signature;
+    });
     return result;
 }
 

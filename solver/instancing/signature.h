@@ -50,7 +50,7 @@ struct SignatureGroup {
 
 struct SceneSignatures {
     std::vector<StructureSignature> structures;  // every instantiable structure, by id
-    std::vector<SignatureGroup> groups;          // by signature
+    std::vector<SignatureGroup> groups;          // by type, then bins, then signature
 
     const StructureSignature* Find(NodeId id) const;  // nullptr when not instantiable
 };
