@@ -1,6 +1,8 @@
 #include "server/policy_cli.h"
 
 #include <algorithm>
+#include <chrono>
+#include <iomanip>
 #include <ostream>
 #include <unordered_map>
 
@@ -56,6 +58,12 @@ Scene SceneOf(const PolicyCheckCommand& command, std::ostream& out) {
     return scene;
 }
 
+// A median of leaf counts is a whole number or a half: "1000000", "12.5", never "1e+06".
+std::string MedianText(double median) {
+    const auto whole = static_cast<std::int64_t>(median);
+    return std::to_string(whole) + (median > static_cast<double>(whole) ? ".5" : "");
+}
+
 }  // namespace
 
 CLI::App* AddPolicyCommand(CLI::App& app, PolicyCheckCommand& command) {
@@ -82,11 +90,15 @@ int RunPolicyCheck(const PolicyCheckCommand& command, std::ostream& out) {
     const InstancingPolicy policy = LoadPolicyFile(command.policy);
     PrintPolicy(policy, out);
     const Scene scene = SceneOf(command, out);
+    const auto start = std::chrono::steady_clock::now();
     const SceneSignatures signatures = ComputeSignatures(scene, policy);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::size_t unbinned = 0;
     for (const StructureSignature& s : signatures.structures) unbinned += s.signature.empty();
     out << signatures.structures.size() << " instantiable structures, " << signatures.groups.size()
-        << " groups, " << unbinned << " in no bin\n";
+        << " groups, " << unbinned << " in no bin (" << std::fixed << std::setprecision(3)
+        << seconds << std::defaultfloat << " s)\n";
     std::unordered_map<NodeId, const Node*> nodes;
     for (const Node& node : scene.nodes) nodes.emplace(node.id, &node);
     for (const SignatureGroup& group : signatures.groups) {
@@ -97,7 +109,8 @@ int RunPolicyCheck(const PolicyCheckCommand& command, std::ostream& out) {
         }
         out << group.signature << "\n  "
             << "members " << group.members.size() << ", leaves " << least << " / "
-            << group.medianLeafCount << " / " << most << " (min / median / max), representative "
+            << MedianText(group.medianLeafCount) << " / " << most
+            << " (min / median / max), representative "
             << scene.NodeName(*nodes.at(group.representative)) << " ("
             << signatures.Find(group.representative)->leafCount << " leaves)\n  ids:";
         const std::size_t shown = command.allMembers
