@@ -114,6 +114,7 @@ TEST(PolicyFile, UnknownFieldNamesFileLineAndColumn) {
     const std::string path = Write("bad_policy.txtpb", text);
     const InputError e = FileError(text);
     EXPECT_EQ(e.Code(), ErrorCode::kParse);
+    // Line 7; protobuf's tokenizer reports the column of the token after the unknown name.
     EXPECT_EQ(e.Field(), path + ":7:13") << e.what();
     EXPECT_NE(std::string(e.what()).find("leaf_counts"), std::string::npos) << e.what();
 }
