@@ -11,6 +11,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <map>
 #include <random>
 #include <set>
 #include <unordered_map>
@@ -238,6 +239,9 @@ TEST(PolicyValidation, NamesAndTypesAreChecked) {
     EXPECT_EQ(PolicyError(policy).Code(), ErrorCode::kAlreadyExists);
     EXPECT_EQ(PolicyError(policy).Field(), "attributes[order].name");
     policy = Minimal();
+    policy.attributes.push_back({"rank|order", {{0, 1}}});
+    EXPECT_EQ(PolicyError(policy).Field(), "attributes[rank|order].name");
+    policy = Minimal();
     policy.attributes.push_back({"", {{0, 1}}});
     EXPECT_EQ(PolicyError(policy).Field(), "attributes[1].name");
     policy = Minimal();
@@ -461,6 +465,24 @@ TEST(SignatureOnGeneratedTree, IndependentOfNodeOrder) {
         EXPECT_EQ(reordered.structures[i].id, ordered.structures[i].id);
         EXPECT_EQ(reordered.structures[i].leafCount, ordered.structures[i].leafCount);
     }
+}
+
+TEST(SignatureOnGeneratedTree, GroupsSpanThePlantsOfAPlantation) {
+    Scene scene = OneBandScene({{"leaf", Leaf(0.1, 0.05)}, {"stem", Opaque(0.3)}});
+    PlantationParameters plantation;
+    plantation.tree.leafCount = 1000;
+    plantation.columns = 3;
+    AddPlantation(scene, plantation, "");
+    scene.Validate();
+    const SceneSignatures signatures =
+        ComputeSignatures(scene, LoadPolicyFile(PolicyPath("generated_tree.txtpb")));
+    std::map<std::string, std::size_t> sizes;
+    for (const auto& group : signatures.groups) sizes[group.signature] = group.members.size();
+    // Each tree as alone (EveryLeafBearingStructureHasOne), three times over.
+    EXPECT_EQ(sizes, (std::map<std::string, std::size_t>{{"plant|leaves[500,1001)|age[0,1)", 3},
+                                                         {"axis|leaves[500,1001)|age[0,1)", 3},
+                                                         {"axis|leaves[50,101)|age[1,2)", 30},
+                                                         {"axis|leaves[5,11)|age[2,3)", 300}}));
 }
 
 TEST(SignatureOnGeneratedTree, FixedSignatureBeyondTheSizeCap) {

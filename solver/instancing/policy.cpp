@@ -133,6 +133,12 @@ void ValidatePolicy(const InstancingPolicy& policy) {
                  "must name a node attribute");
         }
         const std::string field = "attributes[" + attribute.name + "]";
+        // Names stand in signatures ("order[1,2)"): no separators or brackets in them.
+        if (attribute.name.find_first_of("|[](), \t\n") != std::string::npos) {
+            Fail(ErrorCode::kInvalidArgument, field + ".name",
+                 "may not hold '|', brackets, parentheses, commas or spaces: it is part of "
+                 "signatures");
+        }
         if (!names.insert(attribute.name).second) {
             Fail(ErrorCode::kAlreadyExists, field + ".name", "is binned twice");
         }
