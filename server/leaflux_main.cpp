@@ -1,5 +1,6 @@
 // leaflux: the one-shot command line. `solve` lights a scene file, `generate` writes a
-// procedural tree or plantation as a scene file.
+// procedural tree or plantation as a scene file, `policy check` shows the groups an
+// instantiation policy makes.
 #include <fcntl.h>
 #include <google/protobuf/text_format.h>
 #include <spdlog/cfg/env.h>
@@ -19,6 +20,7 @@
 
 #include "server/bench_error.h"
 #include "server/client.h"
+#include "server/policy_cli.h"
 #include "server/scene_proto.h"
 #include "solver/generate/generator.h"
 #include "solver/results/export.h"
@@ -487,11 +489,15 @@ int main(int argc, char** argv) {
     errorApp->add_option("--threads", errorBench.threads, "Worker threads (0: every core)")
         ->check(CLI::Range(0, 1024));
 
+    PolicyCheckCommand policyCheck;
+    CLI::App* policyCheckApp = AddPolicyCommand(app, policyCheck);
+
     CLI11_PARSE(app, argc, argv);
     spdlog::cfg::load_env_levels();  // SPDLOG_LEVEL=debug shows the solvers' phases
     try {
         if (solveApp->parsed()) return RunSolve(solve);
         if (generateApp->parsed()) return RunGenerate(generate);
+        if (policyCheckApp->parsed()) return RunPolicyCheck(policyCheck, std::cout);
         if (errorApp->parsed()) {
             if (errorBench.name.empty()) {
                 errorBench.name = std::filesystem::path(errorBench.scene).stem().stem().string();

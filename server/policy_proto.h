@@ -1,0 +1,23 @@
+// Conversion from the policy file schema (leaflux.v1.InstancingPolicy, policy.proto) to the
+// solver's InstancingPolicy (solver/instancing/policy.h).
+//
+// PolicyFromProto checks what only the schema can get wrong (an unspecified node type or
+// function kind, a direction count no set has, a newer version) and then runs
+// ValidatePolicy: a policy it returns is valid. Errors are InputError naming the field.
+#pragma once
+
+#include <string>
+
+#include "policy.pb.h"
+#include "solver/instancing/policy.h"
+
+namespace leaflux {
+
+InstancingPolicy PolicyFromProto(const v1::InstancingPolicy& message);
+
+// Reads a policy file in protobuf text format. An unreadable file is kIo naming the path;
+// a parse error or an unknown field is kParse naming "path:line:column"; a policy that
+// parses but is not usable is the InputError of PolicyFromProto, naming the field.
+InstancingPolicy LoadPolicyFile(const std::string& path);
+
+}  // namespace leaflux

@@ -1,0 +1,209 @@
+#include "solver/instancing/signature.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+#include <unordered_map>
+
+#include "solver/util/check.h"
+#include "solver/util/error.h"
+
+namespace leaflux {
+namespace {
+
+bool IsLeafOrgan(const Node& node) { return node.type == NodeType::kLeaf && node.organ; }
+
+// Leaf organs in each node's subtree, by position in scene.nodes: children lists, a
+// breadth-first order from the roots, then sums from the last node back to the roots.
+std::vector<std::int64_t> SubtreeLeafCounts(const Scene& scene) {
+    const std::size_t n = scene.nodes.size();
+    std::unordered_map<NodeId, std::size_t> indexOf;
+    indexOf.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) indexOf.emplace(scene.nodes[i].id, i);
+    std::vector<std::size_t> parentOf(n, n);  // n: a root
+    std::vector<std::size_t> childStart(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        const NodeId parent = scene.nodes[i].parent;
+        if (parent == kNoParent) continue;
+        const auto found = indexOf.find(parent);
+        LEAFLUX_CHECK(found != indexOf.end());  // a validated scene's parents resolve
+        parentOf[i] = found->second;
+        ++childStart[found->second + 1];
+    }
+    std::partial_sum(childStart.begin(), childStart.end(), childStart.begin());
+    std::vector<std::size_t> children(childStart[n]);
+    std::vector<std::size_t> fill(childStart.begin(), childStart.end() - 1);
+    for (std::size_t i = 0; i < n; ++i) {
+        if (parentOf[i] != n) children[fill[parentOf[i]]++] = i;
+    }
+    std::vector<std::size_t> order;
+    order.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        if (parentOf[i] == n) order.push_back(i);
+    }
+    for (std::size_t k = 0; k < order.size(); ++k) {
+        const std::size_t i = order[k];
+        order.insert(order.end(), children.begin() + static_cast<std::ptrdiff_t>(childStart[i]),
+                     children.begin() + static_cast<std::ptrdiff_t>(childStart[i + 1]));
+    }
+    LEAFLUX_CHECK(order.size() == n);  // a validated scene is a forest
+    std::vector<std::int64_t> leaves(n, 0);
+    for (auto k = order.rbegin(); k != order.rend(); ++k) {
+        if (IsLeafOrgan(scene.nodes[*k])) ++leaves[*k];
+        if (parentOf[*k] != n) leaves[parentOf[*k]] += leaves[*k];
+    }
+    return leaves;
+}
+
+// Bins `value` for one part of the signature; false (and the reason) when it has none.
+bool AddPart(std::string& signature, std::string& unbinned, const Bins& bins,
+             const std::string& label, const std::string& field, std::optional<double> value,
+             int& bin) {
+    if (!value) {
+        unbinned = "has no attribute " + label + " (" + field + ")";
+        return false;
+    }
+    bin = bins.BinOf(*value);
+    if (bin < 0) {
+        std::ostringstream text;
+        text << label << " " << *value << " lies outside " << field;
+        unbinned = text.str();
+        return false;
+    }
+    if (!signature.empty()) signature += '|';
+    signature += label + bins.Label(bin);
+    return true;
+}
+
+StructureSignature Classify(const Node& node, std::int64_t leafCount,
+                            const InstancingPolicy& policy,
+                            const std::vector<std::size_t>& attributesByName) {
+    StructureSignature s;
+    s.id = node.id;
+    s.type = node.type;
+    s.leafCount = leafCount;
+    s.age = node.age;
+    s.attributeBins.assign(policy.attributes.size(), -1);
+    for (const AttributeBins& attribute : policy.attributes) {
+        const auto found = node.attributes.find(attribute.name);
+        s.attributes.push_back(
+            found == node.attributes.end() ? std::nullopt : std::optional<double>(found->second));
+    }
+    const std::string typeName = NodeTypeName(node.type);
+    if (const FixedFunction* cap = policy.FixedFor(node.type);
+        cap && leafCount > cap->leafCountAbove) {
+        // Soler 2003 §4.1: functions of large structures converge, one original per type.
+        s.fixed = true;
+        s.signature = typeName + "|large";
+        return s;
+    }
+    std::string signature = policy.byType ? typeName : std::string();
+    bool binned = true;
+    if (policy.leafCount.Used()) {
+        binned = AddPart(signature, s.unbinned, policy.leafCount, "leaves", "leaf_count",
+                         static_cast<double>(leafCount), s.leafBin);
+    }
+    if (binned && policy.age.Used()) {
+        binned = AddPart(signature, s.unbinned, policy.age, "age", "age", node.age, s.ageBin);
+    }
+    // Attributes by name, so that their order in the policy file does not change signatures
+    // (PolicyContentHash ignores that order too).
+    for (std::size_t k = 0; binned && k < attributesByName.size(); ++k) {
+        const std::size_t a = attributesByName[k];
+        const AttributeBins& attribute = policy.attributes[a];
+        binned = AddPart(signature, s.unbinned, attribute.bins, attribute.name,
+                         "attributes[" + attribute.name + "]", s.attributes[a], s.attributeBins[a]);
+    }
+    if (binned) s.signature = std::move(signature);
+    return s;
+}
+
+void ChooseRepresentative(SignatureGroup& group, const SceneSignatures& signatures) {
+    std::vector<std::int64_t> counts;
+    counts.reserve(group.members.size());
+    for (const NodeId id : group.members) counts.push_back(signatures.Find(id)->leafCount);
+    std::sort(counts.begin(), counts.end());
+    const std::size_t m = counts.size() / 2;
+    group.medianLeafCount = counts.size() % 2 == 1
+                                ? static_cast<double>(counts[m])
+                                : 0.5 * static_cast<double>(counts[m - 1] + counts[m]);
+    double best = 0.0;
+    for (std::size_t i = 0; i < group.members.size(); ++i) {
+        // Members ascend: the first of equal distances has the smallest id.
+        const NodeId id = group.members[i];
+        const double distance =
+            std::abs(static_cast<double>(signatures.Find(id)->leafCount) - group.medianLeafCount);
+        if (i == 0 || distance < best) {
+            best = distance;
+            group.representative = id;
+        }
+    }
+}
+
+}  // namespace
+
+const StructureSignature* SceneSignatures::Find(NodeId id) const {
+    const auto found =
+        std::lower_bound(structures.begin(), structures.end(), id,
+                         [](const StructureSignature& s, NodeId value) { return s.id < value; });
+    return found != structures.end() && found->id == id ? &*found : nullptr;
+}
+
+SceneSignatures ComputeSignatures(const Scene& scene, const InstancingPolicy& policy) {
+    ValidatePolicy(policy);
+    std::vector<std::size_t> attributesByName(policy.attributes.size());
+    std::iota(attributesByName.begin(), attributesByName.end(), std::size_t{0});
+    std::sort(attributesByName.begin(), attributesByName.end(), [&](std::size_t a, std::size_t b) {
+        return policy.attributes[a].name < policy.attributes[b].name;
+    });
+
+    const std::vector<std::int64_t> leaves = SubtreeLeafCounts(scene);
+    SceneSignatures result;
+    std::vector<bool> carried(policy.attributes.size(), false);
+    for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
+        const Node& node = scene.nodes[i];
+        if (!policy.IsInstanceType(node.type)) continue;
+        for (std::size_t a = 0; a < policy.attributes.size(); ++a) {
+            if (node.attributes.count(policy.attributes[a].name)) carried[a] = true;
+        }
+        if (leaves[i] == 0) continue;  // nothing to light: never an instance
+        result.structures.push_back(Classify(node, leaves[i], policy, attributesByName));
+    }
+    for (std::size_t a = 0; a < policy.attributes.size(); ++a) {
+        if (!carried[a]) {
+            throw InputError(ErrorCode::kNotFound,
+                             "attributes[" + policy.attributes[a].name + "].name",
+                             "no node of an instance type carries this attribute");
+        }
+    }
+    std::sort(result.structures.begin(), result.structures.end(),
+              [](const auto& a, const auto& b) { return a.id < b.id; });
+
+    std::map<std::string, std::vector<NodeId>> members;
+    for (const StructureSignature& s : result.structures) {
+        if (!s.signature.empty()) members[s.signature].push_back(s.id);
+    }
+    for (auto& [signature, ids] : members) {
+        SignatureGroup group;
+        group.signature = signature;
+        group.members = std::move(ids);
+        ChooseRepresentative(group, result);
+        result.groups.push_back(std::move(group));
+    }
+    // By type, then by bins in signature order, so a listing reads from small to large
+    // (the strings alone would put "leaves[1001" before "leaves[101").
+    const auto key = [&](const SignatureGroup& group) {
+        const StructureSignature& s = *result.Find(group.members.front());
+        std::vector<int> bins{static_cast<int>(s.type), s.fixed, s.leafBin, s.ageBin};
+        for (const std::size_t a : attributesByName) bins.push_back(s.attributeBins[a]);
+        return bins;
+    };
+    std::sort(result.groups.begin(), result.groups.end(), [&](const auto& a, const auto& b) {
+        const auto ka = key(a), kb = key(b);
+        return ka != kb ? ka < kb : a.signature < b.signature;
+    });
+    return result;
+}
+
+}  // namespace leaflux
