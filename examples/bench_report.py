@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""The evaluation behind docs/results.md: error against run time on the benchmark scenes
-(`leaflux bench error`), time and memory against size (bench_scaling.py), and the growth of
+"""The evaluation behind docs/results.md and the README's summary table.
+
+Error against run time on the benchmark scenes (`leaflux bench error`), time and memory against size (bench_scaling.py), and the growth of
 the demo. Copies CSVs and plots to examples/report/, then writes each table from those CSVs
 between its `<!-- report:NAME -->` and `<!-- /report:NAME -->` markers, so that the docs say
 what the last run measured and nothing else: docs/results.md holds every table (one section
@@ -209,13 +210,16 @@ def demo_section():
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("build", nargs="?", default=os.path.join(ROOT, "build", "release"))
-    parser.add_argument("out", nargs="?", default=os.path.join(ROOT, "out", "report"))
-    parser.add_argument("--only", default="error,scaling,growth")
-    parser.add_argument("--scenes", default=",".join(SCENES))
+    parser.add_argument("build", nargs="?", default=os.path.join(ROOT, "build", "release"),
+                        help="build directory (default: build/release)")
+    parser.add_argument("out", nargs="?", default=os.path.join(ROOT, "out", "report"),
+                        help="directory of the runs' files (default: out/report)")
+    parser.add_argument("--only", default="error,scaling,growth", help="parts to run (default: all)")
+    parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
     parser.add_argument("--scaling-solvers", default="hrc,mc",
                         help="solvers the scaling run measures; the others' rows are kept from OUT_DIR")
-    parser.add_argument("--demo", default=os.path.join(ROOT, "out", "demo"))
+    parser.add_argument("--demo", default=os.path.join(ROOT, "out", "demo"),
+                        help="growth part: the output of scripts/demo.sh (default: out/demo)")
     parser.add_argument("--tables-only", action="store_true",
                         help="rewrite the tables from the CSVs in examples/report/, run nothing")
     args = parser.parse_args()
