@@ -1,13 +1,16 @@
 #!/usr/bin/env python3
-"""The evaluation behind the README's tables: error against run time on the benchmark
-scenes (`leaflux bench error`), time and memory against size (bench_scaling.py), and the
-growth comparison of the demo. Copies CSVs and plots to examples/report/ and rewrites the
-README between its `<!-- report:NAME -->` and `<!-- /report:NAME -->` markers, so that
-the README says what the last run measured and nothing else (one section per scene).
+"""The evaluation behind docs/results.md and the README's summary table.
+
+Error against run time on the benchmark scenes (`leaflux bench error`), time and memory against size (bench_scaling.py), and the growth of
+the demo. Copies CSVs and plots to examples/report/, then writes each table from those CSVs
+between its `<!-- report:NAME -->` and `<!-- /report:NAME -->` markers, so that the docs say
+what the last run measured and nothing else: docs/results.md holds every table (one section
+per scene), README.md one summary of the error tables (`report:summary`).
 
 Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,scaling,growth] [--scenes a,b]
                       [--scaling-solvers hrc,mc]
-The growth part reads the demo's out/demo/growth_comparison.csv (run scripts/demo.sh).
+       bench_report.py --tables-only [--only ...]   # rewrite from examples/report/, run nothing
+The growth part reads the demo's out/demo/ (run scripts/demo.sh first).
 """
 import argparse
 import csv
@@ -20,6 +23,8 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 REPORT = os.path.join(HERE, "report")
+RESULTS = os.path.join(ROOT, "docs", "results.md")
+README = os.path.join(ROOT, "README.md")
 
 # name: (how to make the scene, what it is, bench error options)
 SCENES = {
@@ -54,19 +59,24 @@ SCENES = {
 }
 
 
-def replace_section(text, name, body):
+def replace_section(path, text, name, body):
     begin, end = f"<!-- report:{name} -->", f"<!-- /report:{name} -->"
     pattern = re.compile(re.escape(begin) + ".*?" + re.escape(end), re.S)
     if not pattern.search(text):
-        sys.exit(f"README.md has no {begin} … {end} section")
+        sys.exit(f"{os.path.relpath(path, ROOT)} has no {begin} … {end} section")
     return pattern.sub(lambda _: f"{begin}\n{body.strip()}\n{end}", text)
 
 
-def update_readme(name, body):
-    """Rewrites one section; the README is read just before, so edits made meanwhile stay."""
-    path = os.path.join(ROOT, "README.md")
-    text = replace_section(open(path).read(), name, body)
+def update(path, name, body):
+    """Rewrites one section of `path`; the file is read just before, so edits made meanwhile
+    stay."""
+    text = replace_section(path, open(path).read(), name, body)
     open(path, "w").write(text)
+
+
+def figure(path, name):
+    """A plot of examples/report/ as linked from the file `path`."""
+    return os.path.relpath(os.path.join(REPORT, name), os.path.dirname(path))
 
 
 def number(value, digits=3):
@@ -77,8 +87,8 @@ def number(value, digits=3):
 
 
 def error_section(build, out, name, run=True):
-    """Runs `leaflux bench error` on one scene (unless not `run`: its CSV is there); returns
-    its README table."""
+    """Runs `leaflux bench error` on one scene and copies its CSV and plot to examples/report/
+    (unless not `run`: they are there); returns its table for docs/results.md."""
     leaflux = os.path.join(build, "server", "leaflux")
     make, description, options = SCENES[name]
     if run:
@@ -90,10 +100,10 @@ def error_section(build, out, name, run=True):
                         "--cache", os.path.join(out, "cache"), *options], check=True)
         for ext in ("csv", "png"):
             shutil.copy(os.path.join(out, f"{name}.{ext}"), os.path.join(REPORT, f"error_{name}.{ext}"))
-    rows = list(csv.DictReader(open(os.path.join(out, f"{name}.csv"))))
+    rows = error_rows(name)
     per = " / ".join(dict.fromkeys(r["band"] for r in rows))
-    table = [f"**{name}** — {description}; {int(rows[0]['leaves']):,} leaves. "
-             f"![{name}](examples/report/error_{name}.png)", "",
+    table = [f"### {name}", "", f"{description[0].upper()}{description[1:]}; {int(rows[0]['leaves']):,} leaves.", "",
+             f"![{name}]({figure(RESULTS, f'error_{name}.png')})", "",
              f"| solver | setting | wall s | cpu s | peak MiB | L2 % of max, {per} | mean rel. %, {per} | "
              f"p95 rel. %, {per} | balance %, {per} |", "|---|---|---|---|---|---|---|---|---|"]
     for key in dict.fromkeys((r["solver"], r["setting"]) for r in rows):
@@ -109,33 +119,67 @@ def error_section(build, out, name, run=True):
     return "\n".join(table)
 
 
-def scaling_section(build, out, solvers):
-    subprocess.run([sys.executable, os.path.join(HERE, "bench_scaling.py"), build, out, "--solvers", solvers],
-                   check=True)
-    for name in ("scaling.csv", "scaling.png", "fits.csv"):
-        shutil.copy(os.path.join(out, name), os.path.join(REPORT, name))
-    rows = list(csv.DictReader(open(os.path.join(out, "scaling.csv"))))
-    table = ["![scaling](examples/report/scaling.png)", "",
+def error_rows(name):
+    return list(csv.DictReader(open(os.path.join(REPORT, f"error_{name}.csv"))))
+
+
+# The README's summary: these settings of each scene's error table.
+SUMMARY = [("mc", "samples", 1024, "Monte Carlo, 1,024 paths"), ("hrc", "epsilon", 1e-4, "HRC, ε = 1e-4"),
+           ("hrc", "epsilon", 1e-5, "HRC, ε = 1e-5")]
+
+
+def summary_section(names):
+    """One row per scene of docs/results.md's error tables: L2 error and wall time of a few
+    settings, for the README."""
+    table = ["| scene | leaves | " + " | ".join(f"{label}: L2 % PAR / NIR, wall s" for *_, label in SUMMARY) + " |",
+             "|---|---|" + "---|" * len(SUMMARY)]
+    for name in names:
+        rows = error_rows(name)
+        cells = []
+        for solver, key, value, _ in SUMMARY:
+            hit = [r for r in rows if r["solver"] == solver and r["setting"].startswith(key + "=")
+                   and float(r["setting"].split("=")[1]) == value]
+            cells.append(" / ".join(number(r["l2_pct_of_max"]) for r in hit) + f", {number(hit[0]['wall_s'])} s"
+                         if hit else "–")
+        table.append(f"| [{name}](docs/results.md#{name}) | {int(rows[0]['leaves']):,} | " + " | ".join(cells) + " |")
+    return "\n".join(table)
+
+
+def scaling_section(build, out, solvers, run=True):
+    if run:
+        subprocess.run([sys.executable, os.path.join(HERE, "bench_scaling.py"), build, out, "--solvers", solvers],
+                       check=True)
+        for name in ("scaling.csv", "scaling.png", "fits.csv"):
+            shutil.copy(os.path.join(out, name), os.path.join(REPORT, name))
+    rows = list(csv.DictReader(open(os.path.join(REPORT, "scaling.csv"))))
+    table = [f"![scaling]({figure(RESULTS, 'scaling.png')})", "",
              "| series | leaves | trees | solver | setting | wall s | peak MiB | links |", "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         figures = (f"{number(r['wall_s'])} | {number(r['peak_mib'])} | {r['links'] or '–'}"
                    if r["status"] == "ok" else f"{r['status']} | | ")
         table.append(f"| {r['series']} | {int(r['leaves']):,} | {r['trees']} | {r['solver']} | {r['setting']} | "
                      f"{figures} |")
-    fits = list(csv.DictReader(open(os.path.join(out, "fits.csv"))))
+    fits = list(csv.DictReader(open(os.path.join(REPORT, "fits.csv"))))
     table += ["", "Fitted growth (time ∝ n^a, peak memory ∝ n^b): " + "; ".join(
         f"{f['solver']} on {f['series']}: a = {f['time_exponent']}, b = {f['memory_exponent']}" for f in fits) + "."]
     return "\n".join(table)
 
 
-def growth_section(demo):
-    source = os.path.join(demo, "growth_comparison.csv")
-    if not os.path.exists(source):
-        sys.exit(f"{source} missing: run scripts/demo.sh first")
-    for ext in ("csv", "png"):
-        shutil.copy(os.path.join(demo, f"growth_comparison.{ext}"), os.path.join(REPORT, f"growth_comparison.{ext}"))
-    rows = list(csv.DictReader(open(source)))
-    table = ["![growth comparison](examples/report/growth_comparison.png)", "",
+# The demo's files copied to examples/report/: (in out/demo/, in examples/report/).
+DEMO_FILES = [("growth_comparison.csv", "growth_comparison.csv"), ("growth_comparison.png", "growth_comparison.png"),
+              ("cycles.csv", "demo_cycles_full.csv"), ("direct_only/cycles.csv", "demo_cycles_direct_only.csv"),
+              ("plants.csv", "demo_plants_full.csv"), ("direct_only/plants.csv", "demo_plants_direct_only.csv"),
+              ("growth.png", "demo_growth.png")]
+
+
+def growth_section(demo, run=True):
+    if run:
+        for source, target in DEMO_FILES:
+            if not os.path.exists(os.path.join(demo, source)):
+                sys.exit(f"{os.path.join(demo, source)} missing: run scripts/demo.sh first")
+            shutil.copy(os.path.join(demo, source), os.path.join(REPORT, target))
+    rows = list(csv.DictReader(open(os.path.join(REPORT, "growth_comparison.csv"))))
+    table = [f"![growth comparison]({figure(RESULTS, 'growth_comparison.png')})", "",
              "| cycle | phytomers | structural distance % | leaf distance % | solve s full / direct | "
              "daemon peak MiB full / direct |", "|---|---|---|---|---|---|"]
     for r in rows:
@@ -147,32 +191,55 @@ def growth_section(demo):
     return "\n".join(table)
 
 
+def demo_section():
+    """The demo's two plants at their first and last cycles (cycles.csv and plants.csv of
+    each run; the wall-hole scenario has one plant)."""
+    table = [f"![growth]({figure(RESULTS, 'demo_growth.png')})", "",
+             "| light | cycle | leaves | leaf area m² | biomass g | PAR absorbed W | leaf-area centroid x m | "
+             "solve s | daemon peak MiB |", "|---|---|---|---|---|---|---|---|---|"]
+    for label, run in (("full", "full"), ("direct only", "direct_only")):
+        rows = list(csv.DictReader(open(os.path.join(REPORT, f"demo_cycles_{run}.csv"))))
+        plants = {p["cycle"]: p for p in csv.DictReader(open(os.path.join(REPORT, f"demo_plants_{run}.csv")))}
+        for r in (rows[0], rows[-1]):
+            table.append(f"| {label} | {r['cycle']} | {r['leaves']} | {number(r['leaf_area_m2'], 4)} | "
+                         f"{number(r['biomass_g'], 4)} | {number(r['absorbed_par_w'], 4)} | "
+                         f"{float(plants[r['cycle']]['centroid_x']):.2f} | {number(r['solve_s'])} | "
+                         f"{number(r['daemon_peak_mib'])} |")
+    return "\n".join(table)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("build")
-    parser.add_argument("out")
-    parser.add_argument("--only", default="error,scaling,growth")
-    parser.add_argument("--scenes", default=",".join(SCENES))
+    parser.add_argument("build", nargs="?", default=os.path.join(ROOT, "build", "release"),
+                        help="build directory (default: build/release)")
+    parser.add_argument("out", nargs="?", default=os.path.join(ROOT, "out", "report"),
+                        help="directory of the runs' files (default: out/report)")
+    parser.add_argument("--only", default="error,scaling,growth", help="parts to run (default: all)")
+    parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
     parser.add_argument("--scaling-solvers", default="hrc,mc",
                         help="solvers the scaling run measures; the others' rows are kept from OUT_DIR")
-    parser.add_argument("--demo", default=os.path.join(ROOT, "out", "demo"))
+    parser.add_argument("--demo", default=os.path.join(ROOT, "out", "demo"),
+                        help="growth part: the output of scripts/demo.sh (default: out/demo)")
     parser.add_argument("--tables-only", action="store_true",
-                        help="rewrite the error tables from the CSVs in OUT_DIR, run nothing")
+                        help="rewrite the tables from the CSVs in examples/report/, run nothing")
     args = parser.parse_args()
     build, out = os.path.abspath(args.build), os.path.abspath(args.out)
+    run = not args.tables_only
     os.makedirs(REPORT, exist_ok=True)
     parts = args.only.split(",")
     if "error" in parts:
         os.makedirs(os.path.join(out, "error"), exist_ok=True)
         for name in args.scenes.split(","):
             # Each table is written as soon as it is measured.
-            update_readme(f"error-{name}",
-                          error_section(build, os.path.join(out, "error"), name, not args.tables_only))
+            update(RESULTS, f"error-{name}", error_section(build, os.path.join(out, "error"), name, run))
+        update(README, "summary", summary_section(list(SCENES)))
     if "scaling" in parts:
-        update_readme("scaling", scaling_section(build, os.path.join(out, "scaling"), args.scaling_solvers))
+        update(RESULTS, "scaling", scaling_section(build, os.path.join(out, "scaling"), args.scaling_solvers, run))
     if "growth" in parts:
-        update_readme("growth", growth_section(args.demo))
-    print(f"README.md sections {args.only} rewritten; files in {REPORT}")
+        update(RESULTS, "growth", growth_section(args.demo, run))
+        update(RESULTS, "demo", demo_section())
+    print(f"sections {args.only} rewritten in docs/results.md"
+          f"{' and the summary in README.md' if 'error' in parts else ''}; files in {REPORT}")
 
 
 if __name__ == "__main__":

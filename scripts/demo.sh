@@ -8,7 +8,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 cmake --preset release -G Ninja > /dev/null
-cmake --build --preset release
+# Only what the demo and the Python examples run (scripts/test.sh builds everything, tests
+# and benchmarks too).
+cmake --build --preset release --target leafluxd leaflux leaflux-grow \
+    leaflux_proto_python leaflux_grow_python
 out=out/demo
 rm -rf "$out" && mkdir -p "$out"
 B=build/release
