@@ -372,3 +372,50 @@ TEST(PhaseFromRadiosity, AgreesWithPhotonsOnALeafCloud) {
 
 }  // namespace
 }  // namespace leaflux
+
+namespace leaflux {
+namespace {
+
+TEST(PhaseFromRadiosity, EveryBeamClosesAndFIsNearlyReciprocal) {
+    // What a beam brings the structure, (1 − τ) A, by rays, against what radiosity makes
+    // of it: scattered out plus absorbed. And f(i, o) against f(o, i).
+    const Scene scene = LeafCloud(60, 0.06, 0.3, 5, {0.45, 0.3, 0.35, 0.35});
+    const StructureAlone cloud(scene, 1);
+    RadiosityPhaseOptions options;
+    options.level = 2;
+    const RadiosityPhase hr = PhaseFromRadiosity(cloud, options);
+    TransmittanceOptions tauOptions;
+    tauOptions.level = 2;
+    tauOptions.raysPerDirection = 65536;
+    const TransmittanceEstimate tau = ComputeTransmittance(cloud, tauOptions);
+    const DirectionSet& set = hr.phase.Directions();
+    const int n = set.Size();
+    double worst = 0.0, rms = 0.0;
+    for (int i = 0; i < n; ++i) {
+        const glm::dvec3 d = set.Direction(i);
+        const double area = cloud.ProjectedArea(d);
+        const double intercepted = (1.0 - double(tau.tau.At(i, 0))) * area;
+        const double error = double(tau.standardError.At(i, 0)) * area;
+        const double closure = hr.scatteredW[i] + hr.absorbedW[i] - intercepted;
+        worst = std::max(worst, std::abs(closure) / intercepted);
+        rms += closure * closure / (intercepted * intercepted) / n;
+        // The rays' error, and radiosity's: ε = 2e-3 of a beam on each link.
+        EXPECT_LE(std::abs(closure), 5.0 * error + 0.02 * intercepted) << "beam " << i;
+    }
+    std::printf("radiosity closure: %.2f %% RMS, worst %.2f %% of the intercepted power\n",
+                100.0 * std::sqrt(rms), 100.0 * worst);
+    double asymmetry = 0.0, scale = 0.0;
+    for (int i = 0; i < n; ++i) {
+        for (int o = 0; o < n; ++o) {
+            const double a = hr.phase.Values()[i * n + o], b = hr.phase.Values()[o * n + i];
+            asymmetry += (a - b) * (a - b);
+            scale += a * a;
+        }
+    }
+    std::printf("radiosity reciprocity: |f − fᵀ| / |f| = %.2f %%\n",
+                100.0 * std::sqrt(asymmetry / scale));
+    EXPECT_LT(std::sqrt(asymmetry / scale), 0.05);
+}
+
+}  // namespace
+}  // namespace leaflux

@@ -70,6 +70,7 @@ RadiosityPhase PhaseFromRadiosity(const StructureAlone& structure,
     for (int i = 0; i < n; ++i)
         for (int b = 0; b < bands; ++b)
             result.scatteredW[i * bands + b] = bi.ScatteredPower(b, set.Direction(i));
+    result.absorbedW = solution.absorbedW;
     result.phase = bi.Reduced(options.kind);
     result.stats = solution.stats;
     result.escapeRays = rays;

@@ -35,6 +35,7 @@ struct RadiosityPhaseOptions {
 struct RadiosityPhase {
     PhaseFunction phase;
     std::vector<double> scatteredW;  // per incoming direction and band: ∫ f dωo
+    std::vector<double> absorbedW;   // per incoming direction and band
     SolveStats stats;
     std::int64_t escapeRays = 0;
     double seconds = 0.0;

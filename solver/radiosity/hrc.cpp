@@ -466,6 +466,7 @@ void SceneSolve::Outputs(Solution& solution) {
 
 void SceneSolve::Patches(BeamSolution& beams) const {
     beams.channels = channels_;
+    beams.absorbedW.assign(channels_.Count(), 0.0);
     const int width = 2 * channels_.Count();
     for (std::uint32_t n : traversal_.Leaves()) {
         const HrcNode& node = hierarchy_[n];
@@ -474,6 +475,12 @@ void SceneSolve::Patches(BeamSolution& beams) const {
         for (int side : {kUpper, kLower}) {
             const double* b = field_.radiosity(n, side);
             beams.radiosity.insert(beams.radiosity.end(), b, b + channels_.Count());
+            // What the side takes and neither reflects nor passes on is absorbed.
+            const double* e = leafLight_.irradiance(n, side);
+            const double* rho = optics_.rho(node.receiver, side);
+            const double* tau = optics_.tau(node.receiver, side);
+            for (int c = 0; c < channels_.Count(); ++c)
+                beams.absorbedW[c] += node.areaM2 * e[c] * (1.0 - rho[c] - tau[c]);
         }
     }
     LEAFLUX_CHECK_EQ(beams.radiosity.size(), beams.patches.size() * width);

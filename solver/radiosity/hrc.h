@@ -119,6 +119,7 @@ struct BeamSolution {
     std::vector<BeamPatch> patches;
     // Exitance (W/m² per W/m² of beam): [patch][side][channel], side kUpper then kLower.
     std::vector<double> radiosity;
+    std::vector<double> absorbedW;  // per channel (W per W/m² of beam)
     SolveStats stats;
     const double* Radiosity(std::size_t patch, int side) const {
         return radiosity.data() + (2 * patch + side) * channels.Count();
