@@ -7,7 +7,7 @@ between its `<!-- report:NAME -->` and `<!-- /report:NAME -->` markers, so that 
 what the last run measured and nothing else: docs/results.md holds every table (one section
 per scene), README.md one summary of the error tables (`report:summary`).
 
-Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,scaling,growth] [--scenes a,b]
+Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,scaling,phase,growth] [--scenes a,b]
                       [--scaling-solvers hrc,mc]
        bench_report.py --tables-only [--only ...]   # rewrite from examples/report/, run nothing
 The growth part reads the demo's out/demo/ (run scripts/demo.sh first).
@@ -208,13 +208,36 @@ def demo_section():
     return "\n".join(table)
 
 
+def phase_sections(build, out, run=True):
+    """Runs leaflux_bench_phase: the paper's §4.2.2 table on a generated branch and the time
+    to compute a structure's functions; returns the two tables."""
+    if run:
+        os.makedirs(out, exist_ok=True)
+        subprocess.run([os.path.join(build, "tests", "leaflux_bench_phase"), out], check=True)
+        for name in ("phase_table.csv", "phase_functions.csv"):
+            shutil.copy(os.path.join(out, name), os.path.join(REPORT, name))
+    rows = list(csv.DictReader(open(os.path.join(REPORT, "phase_table.csv"))))
+    table = ["| function | method | L∞ % | L2 % | size kB | seconds |", "|---|---|---|---|---|---|"]
+    for r in rows:
+        table.append(f"| {r['function']} | {r['method']} | {float(r['linf_pct']):.1f} | "
+                     f"{float(r['l2_pct']):.2f} | {number(r['kB'])} | {number(r['seconds'])} |")
+    rows = list(csv.DictReader(open(os.path.join(REPORT, "phase_functions.csv"))))
+    times = ["| leaves | triangles | function | directions | rays | seconds | kB |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        times.append(f"| {r['leaves']} | {r['triangles']} | {r['function']} | {r['directions']} | "
+                     f"{int(r['rays']):,} | {number(r['seconds'])} | {number(r['kB'])} |")
+    return "\n".join(table), "\n".join(times)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("build", nargs="?", default=os.path.join(ROOT, "build", "release"),
                         help="build directory (default: build/release)")
     parser.add_argument("out", nargs="?", default=os.path.join(ROOT, "out", "report"),
                         help="directory of the runs' files (default: out/report)")
-    parser.add_argument("--only", default="error,scaling,growth", help="parts to run (default: all)")
+    parser.add_argument("--only", default="error,scaling,phase,growth",
+                        help="parts to run (default: all)")
     parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
     parser.add_argument("--scaling-solvers", default="hrc,mc",
                         help="solvers the scaling run measures; the others' rows are kept from OUT_DIR")
@@ -235,6 +258,10 @@ def main():
         update(README, "summary", summary_section(list(SCENES)))
     if "scaling" in parts:
         update(RESULTS, "scaling", scaling_section(build, os.path.join(out, "scaling"), args.scaling_solvers, run))
+    if "phase" in parts:
+        table, times = phase_sections(build, os.path.join(out, "phase"), run)
+        update(RESULTS, "phase-table", table)
+        update(RESULTS, "phase-functions", times)
     if "growth" in parts:
         update(RESULTS, "growth", growth_section(args.demo, run))
         update(RESULTS, "demo", demo_section())

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <numbers>
 #include <optional>
 
 #include "solver/radiosity/closed_scattering.h"
@@ -47,27 +48,33 @@ class Stopwatch {
 constexpr int kRefinementPasses = 3;
 constexpr int kSweepsBeforeRerefining = 30;
 
-// The suns and sky cones of a scene as parallel beams, one channel per band; those that
-// bring nothing are left out.
+// The suns and sky cones of a scene as cones of light (links.h), one channel per band;
+// those that bring nothing are left out.
 std::vector<DirectionalSource> BeamsOf(const Scene& scene, SkyDiscretization skyCones) {
     std::vector<DirectionalSource> sources;
-    const auto add = [&](const glm::dvec3& toward, const std::vector<double>& irradiance) {
-        DirectionalSource source{toward, std::vector<double>(scene.bands.size(), 0.0)};
+    const auto add = [&](const glm::dvec3& toward, const std::vector<double>& irradiance,
+                         double cosRadius) {
+        DirectionalSource source{toward, std::vector<double>(scene.bands.size(), 0.0),
+                                 cosRadius};
         double total = 0.0;
         for (std::size_t b = 0; b < scene.bands.size(); ++b)
             total += source.normalIrradiance[b] = irradiance[b];
         if (total > 0.0) sources.push_back(std::move(source));
     };
-    for (const Sun& sun : scene.sources.suns) add(sun.towardSun, sun.normalIrradianceWm2);
+    for (const Sun& sun : scene.sources.suns)
+        add(sun.towardSun, sun.normalIrradianceWm2, std::cos(sun.angularRadiusRad));
     for (const Sky& sky : scene.sources.skies) {
         Sky discrete = sky;
         if (discrete.discretization == SkyDiscretization::kContinuous)
             discrete.discretization = skyCones;
         for (const SkyCone& cone : discrete.Cones()) {
+            // A circular cone of the cell's solid angle, as the reference takes it: on a
+            // plane facing its axis it brings L ∫ cos = L Ω (1 + cos r) / 2.
+            const double cosRadius = 1.0 - cone.solidAngleSr / (2.0 * std::numbers::pi);
             std::vector<double> irradiance;
             for (double radiance : cone.radianceWm2Sr)
-                irradiance.push_back(radiance * cone.solidAngleSr);
-            add(cone.direction, irradiance);
+                irradiance.push_back(radiance * cone.solidAngleSr * (1.0 + cosRadius) / 2.0);
+            add(cone.direction, irradiance, cosRadius);
         }
     }
     return sources;

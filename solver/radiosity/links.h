@@ -105,10 +105,15 @@ struct SourceLink {
     double visibility;
 };
 
-// A sun or sky cone as the hierarchy sees it: a parallel beam.
+// A sun or sky cone as the hierarchy sees it: light from the directions of a circular cone
+// round `toward` (a parallel beam when cosRadius is 1). Its visibility is taken along
+// directions spread over the cone, so that a leaf is partly shadowed from a sky cone as
+// from the patch of sky it stands for; its irradiance on a plane is normalIrradiance ×
+// the cosine to `toward`, exact for a cone wholly above the plane.
 struct DirectionalSource {
-    glm::dvec3 toward;                     // unit, towards the source
-    std::vector<double> normalIrradiance;  // W/m² normal to the beam, per channel
+    glm::dvec3 toward;                     // unit, towards the source: the cone's axis
+    std::vector<double> normalIrradiance;  // W/m² on a plane facing `toward`, per channel
+    double cosRadius = 1.0;                // of the cone's half-angle
 };
 
 // The links of one hierarchy, by receiver node.

@@ -110,7 +110,7 @@ Refiner::Verdict Refiner::JudgeSource(std::uint32_t r, std::uint32_t s) const {
     if (unoccluded * VisibilitySpread(1.0, visibility_.SourceRays()) > threshold && CanSplit(r))
         return {Verdict::kSplitReceiver, {}, 0.0f, 0};
     Verdict verdict;
-    const double v = visibility_.FromSource(r, s, source.toward, verdict.rays);
+    const double v = visibility_.FromSource(r, s, source, verdict.rays);
     const double error = unoccluded * VisibilitySpread(v, visibility_.SourceRays());
     if (error > threshold && CanSplit(r)) {
         verdict.kind = Verdict::kSplitReceiver;

@@ -83,28 +83,42 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std:
     return sight;
 }
 
-double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source, const glm::dvec3& toward,
-                                  std::int64_t& rays) const {
+double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
+                                  const DirectionalSource& light, std::int64_t& rays) const {
     Random random(StreamSeed(0x50C, r, source));
     const int count = sourceRays_;
+    const bool beam = light.cosRadius >= 1.0;
     thread_local std::vector<RayStart> starts;
+    thread_local std::vector<glm::dvec3> directions;
     thread_local std::vector<double> weights;
     thread_local std::vector<std::uint8_t> occluded;
     thread_local std::vector<std::int32_t> closed;
-    starts.clear(), weights.clear(), closed.clear();
+    starts.clear(), directions.clear(), weights.clear(), closed.clear();
+    // The cone's directions, stratified in its rings and turns and shuffled against the
+    // stratified points.
+    const int rings = beam ? 1 : std::max(1, static_cast<int>(std::sqrt(count)));
     for (int i = 0; i < count; ++i) {
         const Hierarchy::Point p =
             hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
+        glm::dvec3 toward = light.toward;
+        if (!beam) {
+            const int cell = static_cast<int>((i * 7919L) % count);
+            toward = UniformCone(light.toward, light.cosRadius,
+                                 (cell % rings + random.Uniform()) / rings,
+                                 (cell / rings + random.Uniform()) / ((count + rings - 1) / rings));
+            if (toward.z < 0.0 && light.toward.z >= 0.0) toward.z = -toward.z;
+        }
         const double weight = model_.ReceivingWeight(p.triangle, p.normal, toward);
         if (weight <= 0.0) continue;
         starts.push_back({p.position, p.triangle});
+        directions.push_back(toward);
         weights.push_back(weight);
         closed.push_back(p.closed);
     }
     rays += static_cast<std::int64_t>(starts.size());
     double visible = 0.0, total = 0.0;
-    if (occlusion_.ProxyCount() == 0) {  // triangles alone, traced together
-        occlusion_.Triangles().Occluded(starts, toward, occluded);
+    if (occlusion_.ProxyCount() == 0 && beam) {  // triangles alone, one direction: together
+        occlusion_.Triangles().Occluded(starts, light.toward, occluded);
         for (std::size_t i = 0; i < starts.size(); ++i) {
             total += weights[i];
             if (!occluded[i]) visible += weights[i];
@@ -114,8 +128,10 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source, const g
     for (std::size_t i = 0; i < starts.size(); ++i) {
         const std::int32_t ends[2] = {closed[i], -1};
         total += weights[i];
-        visible +=
-            weights[i] * occlusion_.Transmittance(starts[i], toward, INFINITY, Exclusion(ends));
+        visible += weights[i] * (occlusion_.ProxyCount() == 0
+                                     ? !occlusion_.Triangles().Occluded(starts[i], directions[i])
+                                     : occlusion_.Transmittance(starts[i], directions[i], INFINITY,
+                                                                Exclusion(ends)));
     }
     return total > 0.0 ? visible / total : 0.0;
 }

@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 
 #include "solver/radiosity/light_state.h"
+#include "solver/radiosity/links.h"
 #include "solver/radiosity/node_model.h"
 #include "solver/raytrace/occlusion.h"
 
@@ -75,10 +76,12 @@ class LinkVisibility {
     Sight Between(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
                   double unoccluded = 0.0) const;
 
-    // The lit fraction of node r's area as seen from directional source `source`
-    // (towards `toward`): sample points weighted by |n · ω|, the weight with which push-down
-    // hands the source's light to each patch.
-    double FromSource(std::uint32_t r, std::uint32_t source, const glm::dvec3& toward,
+    // The lit fraction of node r's area as seen from directional source `source`: sample
+    // points, each with a direction of the source's cone (stratified over it; one folded
+    // back above the horizon where a sky cone dips below it, as the reference does),
+    // weighted by |n · ω|, the weight with which push-down hands the source's light to each
+    // patch.
+    double FromSource(std::uint32_t r, std::uint32_t source, const DirectionalSource& light,
                       std::int64_t& rays) const;
 
   private:
