@@ -1,5 +1,5 @@
 // leaflux: the one-shot command line. `solve` lights a scene file, `generate` writes a
-// procedural tree or plantation as a scene file.
+// procedural tree or plantation as a scene file, `phase-db` inspects the phase-function database.
 #include <fcntl.h>
 #include <google/protobuf/text_format.h>
 #include <spdlog/cfg/env.h>
@@ -19,6 +19,7 @@
 
 #include "server/bench_error.h"
 #include "server/client.h"
+#include "server/phase_db_cli.h"
 #include "server/scene_proto.h"
 #include "solver/generate/generator.h"
 #include "solver/results/export.h"
@@ -487,6 +488,8 @@ int main(int argc, char** argv) {
     errorApp->add_option("--threads", errorBench.threads, "Worker threads (0: every core)")
         ->check(CLI::Range(0, 1024));
 
+    PhaseDbCli phaseDb(app);
+
     CLI11_PARSE(app, argc, argv);
     spdlog::cfg::load_env_levels();  // SPDLOG_LEVEL=debug shows the solvers' phases
     try {
@@ -510,6 +513,7 @@ int main(int argc, char** argv) {
                       << std::endl;
             return 0;
         }
+        if (phaseDb.Parsed()) return phaseDb.Run();
         if (openApp->parsed()) return RunClient(client, OpenFromFile(client));
         if (cycleApp->parsed()) return RunClient(client, CycleFromFile(client));
         v1::Request request;

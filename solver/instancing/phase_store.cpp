@@ -75,8 +75,21 @@ std::int32_t BigEndian32(const unsigned char* p) {
                                      (std::uint32_t{p[2]} << 8) | std::uint32_t{p[3]});
 }
 
-// Refuses, before SQLite opens it, a file that is not one of ours: SQLite's header holds
-// the application id at byte 68 and the user version at byte 60.
+// The schema version a file holds, refused unless it is this leaflux's.
+void CheckVersion(const std::string& path, std::int64_t version) {
+    if (version > kPhaseSchemaVersion)
+        throw InputError(ErrorCode::kUnsupported, path,
+                         "a phase database of schema version " + std::to_string(version) +
+                             ", newer than this leaflux's " + std::to_string(kPhaseSchemaVersion) +
+                             " (written by a newer leaflux); it is left as it is");
+    if (version < kPhaseSchemaVersion)
+        throw InputError(ErrorCode::kUnsupported, path,
+                         "a phase database of unknown schema version " + std::to_string(version) +
+                             "; it is left as it is");
+}
+
+// Refuses, before SQLite opens it, a file that is not one of ours or is newer: SQLite's
+// header holds the application id at byte 68 and the user version at byte 60.
 void CheckHeader(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in)
@@ -101,24 +114,17 @@ void CheckHeader(const std::string& path) {
         throw InputError(ErrorCode::kParse, path,
                          std::string(text) + ", not a leaflux phase database; it is left as it is");
     }
+    CheckVersion(path, BigEndian32(header + 60));
 }
 
+// The header may lag a WAL not yet checkpointed: the connection's view is the truth.
 void CheckSchemaVersion(SqliteConnection& connection) {
     const std::int64_t id = connection.QueryInt("PRAGMA application_id");
-    const std::int64_t version = connection.QueryInt("PRAGMA user_version");
     if (id != kPhaseApplicationId)
         throw InputError(ErrorCode::kParse, connection.Path(),
                          "not a leaflux phase database (application id " + std::to_string(id) +
                              "); it is left as it is");
-    if (version > kPhaseSchemaVersion)
-        throw InputError(ErrorCode::kUnsupported, connection.Path(),
-                         "a phase database of schema version " + std::to_string(version) +
-                             ", newer than this leaflux's " + std::to_string(kPhaseSchemaVersion) +
-                             " (written by a newer leaflux); it is left as it is");
-    if (version < kPhaseSchemaVersion)
-        throw InputError(ErrorCode::kUnsupported, connection.Path(),
-                         "a phase database of unknown schema version " + std::to_string(version) +
-                             "; it is left as it is");
+    CheckVersion(connection.Path(), connection.QueryInt("PRAGMA user_version"));
 }
 
 // Builds a complete empty database beside `path` and moves it into place without ever
@@ -164,11 +170,15 @@ PhaseStore::PhaseStore(const std::string& path, PhaseStoreMode mode, double disk
         CreateDatabase(path);
     }
     CheckHeader(path);
+    {  // looked at read-only first: a refused file is not even opened for writing
+        SqliteConnection inspection(path, SQLITE_OPEN_READONLY);
+        sqlite3_busy_timeout(inspection.Handle(), 5000);
+        CheckSchemaVersion(inspection);
+    }
     connection_ = std::make_unique<SqliteConnection>(
         path, mode == PhaseStoreMode::kReadOnly ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE);
     // Another process (the daemon, the command line) may be writing: wait for it.
     sqlite3_busy_timeout(connection_->Handle(), 5000);
-    CheckSchemaVersion(*connection_);
     if (Writable()) {
         connection_->Execute("PRAGMA journal_mode = WAL");
         // In WAL mode NORMAL loses no committed transaction when the process dies, only

@@ -1,5 +1,7 @@
 #include "solver/util/sqlite.h"
 
+#include <algorithm>
+
 namespace leaflux {
 
 SqliteError::SqliteError(const std::string& path, int resultCode, const std::string& message)
@@ -19,9 +21,11 @@ SqliteConnection::SqliteConnection(const std::string& path, int flags) : path_(p
 SqliteConnection::~SqliteConnection() { sqlite3_close(db_); }
 
 void SqliteConnection::Fail(int resultCode, std::string_view what) const {
-    throw SqliteError(
-        path_, resultCode,
-        std::string(what) + ": " + sqlite3_errmsg(db_) + " (" + sqlite3_errstr(resultCode) + ")");
+    std::string message = std::string(what) + ": " + sqlite3_errmsg(db_);
+    if (const std::string_view code = sqlite3_errstr(resultCode);
+        message.find(code) == message.npos)
+        message += " (" + std::string(code) + ")";
+    throw SqliteError(path_, resultCode, message);
 }
 
 void SqliteConnection::Execute(const std::string& sql) {
@@ -81,7 +85,11 @@ bool SqliteStatement::Step() {
     if (rc == SQLITE_ROW) return true;
     if (rc == SQLITE_DONE) return false;
     sqlite3_reset(statement_);
-    connection_.Fail(rc, sqlite3_sql(statement_));
+    // Named by its first words ("INSERT INTO phase_functions"), not its whole text.
+    std::string_view sql = sqlite3_sql(statement_);
+    sql.remove_prefix(std::min(sql.find_first_not_of(" \n"), sql.size()));
+    sql = sql.substr(0, std::min<std::size_t>(sql.find_first_of("(\n"), 48));
+    connection_.Fail(rc, sql.substr(0, sql.find_last_not_of(' ') + 1));
 }
 
 std::int64_t SqliteStatement::Int(int column) const {
