@@ -156,6 +156,7 @@ PhaseDbCli::PhaseDbCli(CLI::App& parent) {
         "Inspect the phase-function database: the originals (phase function f and "
         "transmittance τ of a signature) leafluxd computed and kept");
     app_->require_subcommand(1);
+    app_->fallthrough();  // `phase-db verify --db PATH` as well as `phase-db --db PATH verify`
     app_->add_option("--db", path_, "The database file")->capture_default_str();
     stats_ = app_->add_subcommand("stats", "Functions by kind, file and log sizes");
     list_ = app_->add_subcommand(

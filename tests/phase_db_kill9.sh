@@ -13,6 +13,7 @@ leaflux=$build/server/leaflux
 RANDOM=2026  # the same moments each run
 
 for run in $(seq "$kills"); do
+    : > "$out/committed.$run"  # a writer killed before its exec opens nothing
     "$writer" "$db" "$run" > "$out/committed.$run" 2>> "$out/writer.err" &
     pid=$!
     # 0 to 0.4 s; the first runs die sooner, while the file is made
