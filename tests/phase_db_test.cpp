@@ -291,6 +291,41 @@ TEST(PhaseDbConcurrency, AFailedComputationReachesItsWaitersAndStoresNothing) {
               PhaseSource::kComputed);
 }
 
+TEST(PhaseDbConcurrency, ManyThreadsOnOverlappingKeysComputeEachOnce) {
+    TemporaryDirectory directory;
+    // A small buffer, so that evictions and reloads from the file run among the requests.
+    const Original original = SyntheticOriginal(PhaseKind::kMonoDirectional, 3, 2, 1);
+    PhaseDatabase db(OnFile(directory.File("phase.db"), 10.5 * OriginalBytes(original) / 1e6));
+    constexpr int kKeys = 40;
+    std::vector<std::atomic<int>> calls(kKeys);
+    std::latch start(8);
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 8; ++t) {
+        threads.emplace_back([&, t] {
+            start.arrive_and_wait();
+            for (int round = 0; round < 200; ++round) {
+                const int k = (round * 7 + t * 3) % kKeys;
+                const PhaseLookup lookup = db.GetOrCompute(
+                    SyntheticKey("k" + std::to_string(k), PhaseKind::kMonoDirectional, 3), [&] {
+                        ++calls[k];
+                        return original;
+                    });
+                EXPECT_TRUE(SameValues(*lookup.original, original));
+            }
+        });
+    }
+    for (std::thread& thread : threads) thread.join();
+    for (int k = 0; k < kKeys; ++k) EXPECT_EQ(calls[k], 1) << "key " << k;
+    const PhaseDatabaseStats stats = db.Stats();
+    EXPECT_EQ(stats.computed, kKeys);
+    EXPECT_EQ(stats.stored, kKeys);
+    EXPECT_GT(stats.evictions, 0);
+    EXPECT_GT(stats.diskHits, 0);
+    EXPECT_EQ(stats.memoryHits + stats.diskHits + stats.awaited + stats.misses, 8 * 200);
+    EXPECT_TRUE(db.Verify().Ok());
+    EXPECT_EQ(db.List().size(), static_cast<std::size_t>(kKeys));
+}
+
 TEST(PhaseDbKey, AKeyDifferingInAnyFieldIsAMiss) {
     TemporaryDirectory directory;
     PhaseDatabase db(OnFile(directory.File("phase.db")));
@@ -393,6 +428,7 @@ void ExpectRefused(const std::string& path, ErrorCode code) {
     PhaseDatabase db(options);
     EXPECT_FALSE(db.Persistent());
     EXPECT_NE(db.OpenError().find(path), std::string::npos);
+    EXPECT_THROW(db.Verify(), InputError);
     EXPECT_EQ(db.Stats().health, db.OpenError());
     const CountingCompute compute = Counting(1);
     EXPECT_EQ(db.GetOrCompute(SyntheticKey("m"), compute.Function()).source,

@@ -196,6 +196,34 @@ void PhaseDatabase::NoteError(std::int64_t PhaseDatabaseStats::*counter,
     lastError_ = message;
 }
 
+PhaseStore& PhaseDatabase::OpenStore() {
+    if (!store_)
+        throw InputError(
+            ErrorCode::kNotFound, options_.path,
+            openError_.empty() ? "no phase database file is open" : "not open: " + openError_);
+    return *store_;
+}
+
+std::vector<PhaseRowInfo> PhaseDatabase::List() {
+    std::lock_guard storeLock(storeMutex_);
+    return OpenStore().List();
+}
+
+PhaseVerifyReport PhaseDatabase::Verify() {
+    std::lock_guard storeLock(storeMutex_);
+    return OpenStore().Verify();
+}
+
+PhaseFileStats PhaseDatabase::FileStats() {
+    std::lock_guard storeLock(storeMutex_);
+    return OpenStore().Stats();
+}
+
+void PhaseDatabase::Compact() {
+    std::lock_guard storeLock(storeMutex_);
+    OpenStore().Compact();
+}
+
 PhaseDatabaseStats PhaseDatabase::Stats() const {
     std::lock_guard lock(mutex_);
     PhaseDatabaseStats stats = stats_;

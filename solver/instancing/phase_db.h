@@ -73,8 +73,16 @@ class PhaseDatabase {
     ~PhaseDatabase();
 
     // The original of `key`: from memory, else from the file, else `compute()` (run at most
-    // once at a time per key, its result stored). Rethrows what compute throws.
+    // once at a time per key, its result stored). Rethrows what compute throws. `compute`
+    // must not ask for its own key: it would wait for itself.
     PhaseLookup GetOrCompute(const PhaseKey& key, const std::function<Original()>& compute);
+
+    // The open file's rows, soundness and size, and its compaction (PhaseStore's, through
+    // this database's connection). Throw InputError(kNotFound) when no file is open.
+    std::vector<PhaseRowInfo> List();
+    PhaseVerifyReport Verify();
+    PhaseFileStats FileStats();
+    void Compact();
 
     PhaseDatabaseStats Stats() const;
     // "" when the file is open and every write so far succeeded; else what went wrong,
@@ -99,6 +107,7 @@ class PhaseDatabase {
     void Store(const PhaseKey& key, const Original& original);
     void Remember(const std::string& canonical, std::shared_ptr<const Original> original);
     void NoteError(std::int64_t PhaseDatabaseStats::*counter, const std::string& message);
+    PhaseStore& OpenStore();  // throws when there is none
 
     PhaseDatabaseOptions options_;
     std::string openError_;

@@ -252,27 +252,37 @@ std::vector<PhaseRowInfo> PhaseStore::List() {
 
 PhaseVerifyReport PhaseStore::Verify() {
     PhaseVerifyReport report;
-    SqliteStatement integrity(*connection_, "PRAGMA integrity_check");
-    while (integrity.Step()) report.integrity.push_back(integrity.Text(0));
-    SqliteStatement select(*connection_, std::string("SELECT ") + kRowColumns +
-                                             ", checksum, blob FROM phase_functions ORDER BY id");
-    while (select.Step()) {
-        ++report.rows;
-        PhaseRow row = ReadRow(select);
-        std::string reason;
-        if (!row.checksumOk) {
-            reason = "checksum mismatch";
-        } else {
-            try {
-                DecodeOriginal(row.blob, Path() + ":" + std::to_string(row.info.id));
-            } catch (const InputError& e) {
-                reason = e.what();
+    // A damaged page may stop either scan: that is a finding, not a failure to verify.
+    try {
+        SqliteStatement integrity(*connection_, "PRAGMA integrity_check");
+        while (integrity.Step()) report.integrity.push_back(integrity.Text(0));
+    } catch (const SqliteError& e) {
+        report.integrity.push_back(std::string("integrity_check stopped: ") + e.what());
+    }
+    try {
+        SqliteStatement select(*connection_,
+                               std::string("SELECT ") + kRowColumns +
+                                   ", checksum, blob FROM phase_functions ORDER BY id");
+        while (select.Step()) {
+            ++report.rows;
+            PhaseRow row = ReadRow(select);
+            std::string reason;
+            if (!row.checksumOk) {
+                reason = "checksum mismatch";
+            } else {
+                try {
+                    DecodeOriginal(row.blob, Path() + " row " + std::to_string(row.info.id));
+                } catch (const InputError& e) {
+                    reason = e.what();
+                }
+            }
+            if (!reason.empty()) {
+                report.badRows.push_back(std::move(row.info));
+                report.badReasons.push_back(std::move(reason));
             }
         }
-        if (!reason.empty()) {
-            report.badRows.push_back(std::move(row.info));
-            report.badReasons.push_back(std::move(reason));
-        }
+    } catch (const SqliteError& e) {
+        report.integrity.push_back(std::string("the rows' scan stopped: ") + e.what());
     }
     return report;
 }
