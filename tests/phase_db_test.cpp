@@ -174,6 +174,27 @@ TEST(PhaseDbStore, RoundTripThroughDiskAcrossReopening) {
     EXPECT_GT(stats.loadSeconds, 0.0);
 }
 
+TEST(PhaseDbStore, MakesItsDirectoryAndOnlyReadsWhenAskedTo) {
+    TemporaryDirectory directory;
+    const std::string path = directory.File("data/leaflux/phase.db");
+    EXPECT_THROW(PhaseStore(path, PhaseStoreMode::kReadOnly), InputError);
+    EXPECT_THROW(PhaseStore(path, PhaseStoreMode::kExisting), InputError);
+    EXPECT_FALSE(fs::exists(path));
+    PhaseDatabase(OnFile(path)).GetOrCompute(SyntheticKey("a"), Counting(1).Function());
+    EXPECT_EQ(PhaseStore(path, PhaseStoreMode::kReadOnly).Stats().rows, 1);
+    // Nothing is left beside it but the database and SQLite's own -wal and -shm.
+    for (const auto& entry : fs::directory_iterator(fs::path(path).parent_path())) {
+        const std::string name = entry.path().filename();
+        EXPECT_TRUE(name == "phase.db" || name == "phase.db-wal" || name == "phase.db-shm") << name;
+    }
+    try {
+        PhaseStore store(directory.Path(), PhaseStoreMode::kCreate);
+        ADD_FAILURE() << "a directory was opened";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.Field(), directory.Path());
+    }
+}
+
 TEST(PhaseDbStore, VerifyListStatsAndCompactDescribeTheFile) {
     TemporaryDirectory directory;
     const std::string path = directory.File("phase.db");

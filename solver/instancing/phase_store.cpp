@@ -91,6 +91,8 @@ void CheckVersion(const std::string& path, std::int64_t version) {
 // Refuses, before SQLite opens it, a file that is not one of ours or is newer: SQLite's
 // header holds the application id at byte 68 and the user version at byte 60.
 void CheckHeader(const std::string& path) {
+    if (!std::filesystem::is_regular_file(path))
+        throw InputError(ErrorCode::kIo, path, "not a regular file; it is left as it is");
     std::ifstream in(path, std::ios::binary);
     if (!in)
         throw InputError(ErrorCode::kIo, path, "cannot be read: " + std::string(strerror(errno)));
@@ -131,30 +133,31 @@ void CheckSchemaVersion(SqliteConnection& connection) {
 // replacing a file: if another process got there first, its file is kept.
 void CreateDatabase(const std::string& path) {
     namespace fs = std::filesystem;
-    std::error_code error;
+    std::error_code ignored;  // a directory that cannot be made fails the open below
     const fs::path parent = fs::path(path).parent_path();
-    if (!parent.empty()) fs::create_directories(parent, error);
+    if (!parent.empty()) fs::create_directories(parent, ignored);
     static std::atomic<int> counter{0};
     const std::string temporary =
         path + ".new-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-    {
+    try {
         SqliteConnection connection(temporary, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
         connection.Execute("PRAGMA application_id = " + std::to_string(kPhaseApplicationId));
         connection.Execute("PRAGMA user_version = " + std::to_string(kPhaseSchemaVersion));
         connection.Execute(kSchema);
         connection.Execute("PRAGMA journal_mode = WAL");
     }  // closing checkpoints the WAL into the file and removes it
-    int rc = ::renameat2(AT_FDCWD, temporary.c_str(), AT_FDCWD, path.c_str(), RENAME_NOREPLACE);
-    if (rc != 0 && errno == EINVAL) {  // a file system without renameat2: link is as safe
-        rc = ::link(temporary.c_str(), path.c_str());
-        if (rc == 0 || errno == EEXIST) ::unlink(temporary.c_str());
-    }
-    if (rc != 0 && errno != EEXIST) {
-        const std::string reason = strerror(errno);
+    catch (const SqliteError& e) {
         ::unlink(temporary.c_str());
-        throw InputError(ErrorCode::kIo, path, "cannot be created: " + reason);
+        throw InputError(ErrorCode::kIo, path, std::string("cannot be created: ") + e.what());
     }
-    if (rc != 0) ::unlink(temporary.c_str());  // another process made it meanwhile
+    int rc = ::renameat2(AT_FDCWD, temporary.c_str(), AT_FDCWD, path.c_str(), RENAME_NOREPLACE);
+    if (rc != 0 && errno == EINVAL) rc = ::link(temporary.c_str(), path.c_str());  // no renameat2
+    const int error = rc == 0 ? 0 : errno;
+    ::unlink(temporary.c_str());  // gone after a rename; after a link or a loss, not needed
+    // EEXIST: another process made it meanwhile, and its file is the one kept.
+    if (error != 0 && error != EEXIST)
+        throw InputError(ErrorCode::kIo, path,
+                         std::string("cannot be created: ") + strerror(error));
 }
 
 }  // namespace
