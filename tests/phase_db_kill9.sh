@@ -37,7 +37,9 @@ done | sort -u > "$out/committed"
 missing=$(comm -23 "$out/committed" "$out/present" | wc -l)
 committed=$(wc -l < "$out/committed")
 present=$(wc -l < "$out/present")
-echo "$kills kills: $committed rows reported committed, $present rows in the file, $missing missing"
+# Rows in the file but never reported: kills that fell between a commit and its report.
+echo "$kills kills: $committed rows reported committed, $present rows in the file" \
+    "($((present - committed)) committed but not yet reported), $missing missing"
 tail -1 "$out/verify.txt"
 if [ "$committed" -eq 0 ]; then echo "FAIL: no row was ever committed"; exit 1; fi
 if [ "$missing" -ne 0 ]; then

@@ -60,10 +60,11 @@ struct PhaseDatabaseStats {
     std::int64_t computed = 0;  // misses + bad rows, the computations that finished
     std::int64_t badRows = 0;   // rows found corrupt, recomputed and overwritten
     std::int64_t stored = 0, writeErrors = 0, readErrors = 0, evictions = 0;
-    double loadSeconds = 0.0, computeSeconds = 0.0, storeSeconds = 0.0;  // summed
-    std::int64_t memoryBytes = 0, memoryEntries = 0;
-    bool persistent = false;  // a file is open
-    std::string health;       // "" when sound, else the last open, read or write error
+    // Summed over requests (s): reading and decoding rows, computing, encoding and writing.
+    double loadSeconds = 0.0, computeSeconds = 0.0, storeSeconds = 0.0;
+    std::int64_t memoryBytes = 0, memoryEntries = 0;  // the LRU buffer now (OriginalBytes)
+    bool persistent = false;                          // a file is open
+    std::string health;  // "" when sound, else the last open, read or write error
 };
 
 class PhaseDatabase {
