@@ -1,6 +1,6 @@
 // leaflux: the one-shot command line. `solve` lights a scene file, `generate` writes a
 // procedural tree or plantation as a scene file, `policy check` shows the groups an
-// instantiation policy makes.
+// instantiation policy makes, `phase-db` inspects the phase-function database.
 #include <fcntl.h>
 #include <google/protobuf/text_format.h>
 #include <spdlog/cfg/env.h>
@@ -21,6 +21,7 @@
 #include "server/bench_error.h"
 #include "server/client.h"
 #include "server/policy_cli.h"
+#include "server/phase_db_cli.h"
 #include "server/scene_proto.h"
 #include "solver/generate/generator.h"
 #include "solver/results/export.h"
@@ -491,6 +492,7 @@ int main(int argc, char** argv) {
 
     PolicyCheckCommand policyCheck;
     CLI::App* policyCheckApp = AddPolicyCommand(app, policyCheck);
+    PhaseDbCli phaseDb(app);
 
     CLI11_PARSE(app, argc, argv);
     spdlog::cfg::load_env_levels();  // SPDLOG_LEVEL=debug shows the solvers' phases
@@ -516,6 +518,7 @@ int main(int argc, char** argv) {
                       << std::endl;
             return 0;
         }
+        if (phaseDb.Parsed()) return phaseDb.Run();
         if (openApp->parsed()) return RunClient(client, OpenFromFile(client));
         if (cycleApp->parsed()) return RunClient(client, CycleFromFile(client));
         v1::Request request;
