@@ -352,7 +352,7 @@ TEST(PhaseDbKey, AKeyDifferingInAnyFieldIsAMiss) {
     PhaseDatabase db(OnFile(directory.File("phase.db")));
     const PhaseKey base = SyntheticKey("type=axis;leaves=2");
     db.GetOrCompute(base, Counting(1).Function());
-    std::vector<PhaseKey> variants(9, base);
+    std::vector<PhaseKey> variants(10, base);
     variants[0].species = "oak";
     variants[1].policyHash = "00112233445566ab";
     variants[2].signature = "type=axis;leaves=3";
@@ -362,6 +362,7 @@ TEST(PhaseDbKey, AKeyDifferingInAnyFieldIsAMiss) {
     variants[6].kind = PhaseKind::kMonoDirectional;
     variants[7].directionLevel = 3;
     variants[8].codeVersion = kPhaseCodeVersion + 1;
+    variants[9].settings = "mc photons=40000";
     for (std::size_t v = 0; v < variants.size(); ++v) {
         EXPECT_NE(variants[v].Canonical(), base.Canonical()) << v;
         EXPECT_EQ(db.GetOrCompute(variants[v], Counting(2).Function()).source,

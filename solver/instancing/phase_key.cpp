@@ -37,7 +37,7 @@ std::string PhaseKey::Canonical() const {
            "|policy=" + Escaped(policyHash) + "|signature=" + Escaped(signature) +
            "|optics=" + Escaped(opticsHash) + "|bands=" + std::to_string(bands.size()) + ":" +
            JoinBands(bands) + "|kind=" + PhaseKindName(kind) +
-           "|level=" + std::to_string(directionLevel);
+           "|level=" + std::to_string(directionLevel) + "|settings=" + Escaped(settings);
 }
 
 std::string PhaseKey::HashHex() const { return ContentHash().Add(Canonical()).Hex(); }

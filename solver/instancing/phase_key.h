@@ -24,6 +24,9 @@ struct PhaseKey {
     std::vector<std::string> bands;  // band names, in the order of the function's bands
     PhaseKind kind = PhaseKind::kBiDirectional;
     int directionLevel = 0;  // DirectionSet level (0..4) of f's directions
+    // How the functions are computed (method, accuracy, τ's resolution): "" when a caller
+    // keys on nothing more; see OriginalSettings::Describe.
+    std::string settings;
     int codeVersion = kPhaseCodeVersion;
 
     // One line naming every field, unambiguous whatever the strings hold ('|', '=' and ','
