@@ -390,6 +390,31 @@ def test_resync_after_a_restart():
     assert isinstance(LocalDaemon, type) and pb.PROTOCOL_VERSION_CURRENT == 1
 
 
+def test_curve():
+    import zmq
+    from leaflux import Client, RequestTimeout
+    if not zmq.has("curve"):
+        skip("this libzmq has no CurveZMQ")
+    public, secret = zmq.curve_keypair()
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "server.secret")
+        with open(os.open(path, os.O_WRONLY | os.O_CREAT, 0o600), "w") as f:
+            f.write(secret.decode() + "\n")
+        with open(os.path.join(tmp, "server.public"), "w") as f:
+            f.write(public.decode() + "\n")
+        with daemon(curve_secret_key=path) as d:
+            assert d.curve_server_key == public.decode()
+            for key in (d.curve_server_key, os.path.join(tmp, "server.public")):
+                with Client(d.endpoint, timeout_s=5, curve_server_key=key) as client:
+                    assert client.status().session_count == 0
+            with Client(d.endpoint, timeout_s=0.3) as plain:  # no key: never answered
+                try:
+                    plain.status()
+                    raise AssertionError("a connection without CurveZMQ was answered")
+                except RequestTimeout:
+                    pass
+
+
 def test_local_daemon_not_found():
     from leaflux import DaemonStartError, LocalDaemon
     missing = os.path.join(tempfile.gettempdir(), "no-such-dir", "leafluxd")

@@ -32,9 +32,15 @@ def generated_modules(proto_dir: str, out_dir: str) -> list[str]:
     return [os.path.join(out_dir, p.replace(".proto", "_pb2.py")) for p in PROTOS]
 
 
+def generated_stubs(out_dir: str) -> list[str]:
+    return [os.path.join(out_dir, p.replace(".proto", "_pb2.pyi")) for p in PROTOS]
+
+
 def stale(proto_dir: str, out_dir: str) -> bool:
-    """Whether a module is missing or older than its .proto."""
-    for proto, module in zip(PROTOS, generated_modules(proto_dir, out_dir)):
+    """Whether a module or its stub is missing or older than its .proto."""
+    files = zip([*PROTOS, *PROTOS], [*generated_modules(proto_dir, out_dir),
+                                     *generated_stubs(out_dir)])
+    for proto, module in files:
         if not os.path.exists(module):
             return True
         if os.path.getmtime(module) < os.path.getmtime(os.path.join(proto_dir, proto)):
@@ -43,7 +49,8 @@ def stale(proto_dir: str, out_dir: str) -> bool:
 
 
 def generate(proto_dir: str, out_dir: str) -> list[str]:
-    """Runs `protoc --python_out` on proto_dir's files into out_dir, the package's folder.
+    """Runs `protoc --python_out --pyi_out` on proto_dir's files into out_dir, the package's
+    folder.
 
     The generated modules import each other as top-level modules (`import leaflux_pb2`);
     they are rewritten to import within the package. Each module is written to a temporary
@@ -55,7 +62,7 @@ def generate(proto_dir: str, out_dir: str) -> list[str]:
         raise FileNotFoundError(f"leaflux: {', '.join(missing)} not found in {proto_dir}")
     os.makedirs(out_dir, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="leaflux_protoc_") as tmp:
-        command = [protoc, f"--python_out={tmp}", "-I", proto_dir,
+        command = [protoc, f"--python_out={tmp}", f"--pyi_out={tmp}", "-I", proto_dir,
                    *(os.path.join(proto_dir, p) for p in PROTOS)]
         run = subprocess.run(command, capture_output=True, text=True)
         if run.returncode != 0:
@@ -63,8 +70,8 @@ def generate(proto_dir: str, out_dir: str) -> list[str]:
                                f"{run.stderr.strip()}")
         written = []
         siblings = [p[: -len(".proto")] + "_pb2" for p in PROTOS]
-        for proto in PROTOS:
-            name = proto.replace(".proto", "_pb2.py")
+        # The modules, then their type stubs (for type checkers).
+        for name in [p.replace(".proto", "_pb2.py" + ext) for ext in ("", "i") for p in PROTOS]:
             with open(os.path.join(tmp, name)) as f:
                 code = f.read()
             for sibling in siblings:

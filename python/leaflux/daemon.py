@@ -10,6 +10,8 @@ import tempfile
 import time
 from typing import List, Optional, Sequence, Union
 
+import zmq
+
 from .client import Client
 from .errors import DaemonStartError, RequestTimeout
 
@@ -54,13 +56,23 @@ class LocalDaemon:
 
     `endpoint` is where to connect; `args` are more leafluxd options (e.g.
     ["--workers", "4"]); `solver_threads` caps each solve's cores; the daemon's log goes
-    to `log_file` (a temporary file otherwise, removed at stop; `log()` reads it)."""
+    to `log_file` (a temporary file otherwise, removed at stop; `log()` reads it).
+    `curve_secret_key`: the path of a CurveZMQ secret key (`leaflux keygen`): the daemon then
+    encrypts every connection, and `curve_server_key` is the public key clients pass to
+    Client(..., curve_server_key=)."""
 
     def __init__(self, leafluxd: Optional[PathLike] = None, port: Optional[int] = None, *,
                  args: Sequence[str] = (), solver_threads: Optional[int] = None,
                  log_file: Optional[PathLike] = None, start_timeout_s: float = 30.0,
-                 stop_timeout_s: float = 30.0) -> None:
+                 stop_timeout_s: float = 30.0,
+                 curve_secret_key: Optional[PathLike] = None) -> None:
         self.leafluxd = find_leafluxd(leafluxd)
+        self.curve_server_key: Optional[str] = None
+        if curve_secret_key is not None:
+            with open(curve_secret_key) as f:
+                secret = f.read().strip().encode()
+            self.curve_server_key = zmq.curve_public(secret).decode()
+            args = [*args, "--curve-secret-key", os.fspath(curve_secret_key)]
         self.stop_timeout_s = stop_timeout_s
         self._own_log = log_file is None
         if log_file is None:
@@ -109,7 +121,8 @@ class LocalDaemon:
                 raise DaemonStartError(f"leaflux: {' '.join(self.command)} did not start "
                                        f"serving within {timeout_s:g} s")
             time.sleep(0.02)
-        with Client(self.endpoint, timeout_s=0.5) as probe:
+        with Client(self.endpoint, timeout_s=0.5,
+                    curve_server_key=self.curve_server_key) as probe:
             while True:
                 try:
                     probe.status()
@@ -154,5 +167,6 @@ class LocalDaemon:
         self.stop()
 
     def __del__(self) -> None:
-        if getattr(self, "_process", None) is not None and self._process.poll() is None:
-            self._process.kill()
+        process = getattr(self, "_process", None)
+        if process is not None and process.poll() is None:
+            process.kill()

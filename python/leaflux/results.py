@@ -162,14 +162,13 @@ class CycleLight:
         rows: List[Dict[str, Any]] = []
         items: Iterable[Union[OrganLight, StructureLight]] = [*self.organs, *self.structures]
         for item in items:
-            structure = isinstance(item, StructureLight)
+            kind, type_, organs = (("structure", item.type, item.organs)
+                                   if isinstance(item, StructureLight) else ("organ", "", 1))
             for b in item.bands:
                 v = b.light_vector
                 rows.append({
-                    "cycle": self.number, "kind": "structure" if structure else "organ",
-                    "node": item.node, "name": item.name,
-                    "type": item.type if structure else "",
-                    "organs": item.organs if structure else 1,
+                    "cycle": self.number, "kind": kind,
+                    "node": item.node, "name": item.name, "type": type_, "organs": organs,
                     "area_m2": item.area_m2, "band": b.band,
                     "irradiance_upper_wm2": b.irradiance_upper_wm2,
                     "irradiance_lower_wm2": b.irradiance_lower_wm2,
