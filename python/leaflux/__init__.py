@@ -38,7 +38,7 @@ from .errors import (ERROR_CLASSES, AlreadyExists, DaemonError, DaemonStartError
                      TooLarge, UnknownSession, Unsupported)
 from .results import (CSV_COLUMNS, BandLight, CycleLight, EnergyBalance, OrganLight,  # noqa: E402
                       SolveStatistics, StructureLight, Vector)
-from .scene import band_light, frame  # noqa: E402
+from .scene import band_light, frame, read_scene  # noqa: E402
 
 __version__ = "0.1.0"
 
@@ -49,5 +49,5 @@ __all__ = [
     "ParentCycle", "ParseError", "FileError", "Unsupported", "UnknownSession", "TooLarge",
     "ShuttingDown", "InternalError", "ERROR_CLASSES", "CycleLight", "OrganLight",
     "StructureLight", "BandLight", "Vector", "SolveStatistics", "EnergyBalance",
-    "CSV_COLUMNS", "band_light", "frame",
+    "CSV_COLUMNS", "band_light", "frame", "read_scene",
 ]

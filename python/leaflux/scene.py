@@ -1,7 +1,8 @@
 """Small helpers to build protocol messages."""
 from __future__ import annotations
 
-from typing import Any, Sequence
+import os
+from typing import Any, Sequence, Union
 
 from . import leaflux_pb2 as pb
 
@@ -20,3 +21,21 @@ def band_light(organ: Any, band: str) -> Any:
         if b.band == band:
             return b
     raise KeyError(f"no band {band!r} in the light of {organ.name or organ.node}")
+
+
+def read_scene(path: Union[str, "os.PathLike[str]"]) -> "pb.Scene":
+    """A pb.Scene from a scene file: protobuf text format (.txtpb, .pbtxt, .txt), binary
+    otherwise. (OBJ, .can and OPF imports are the daemon's and `leaflux`'s.)"""
+    from google.protobuf import text_format
+    name = os.fspath(path)
+    scene = pb.Scene()
+    if name.endswith((".txtpb", ".pbtxt", ".txt")):
+        with open(name) as f:
+            try:
+                text_format.Parse(f.read(), scene)
+            except text_format.ParseError as e:
+                raise ValueError(f"{name}:{e}") from None
+    else:
+        with open(name, "rb") as f:
+            scene.ParseFromString(f.read())
+    return scene
