@@ -457,6 +457,8 @@ def install_and_run():
         python = os.path.join(env, "bin", "python")
         made = subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", env],
                               capture_output=True, text=True)
+        if os.environ.get("LEAFLUX_TEST_TARGET"):  # to test the fallback
+            made.returncode, made.stderr = 1, "LEAFLUX_TEST_TARGET is set"
         if made.returncode == 0:
             install = [python, "-m", "pip", "install"]
             prefix = env
@@ -464,7 +466,7 @@ def install_and_run():
         else:  # no venv module (Debian python3-venv): a --target folder instead
             print(f"no venv ({made.stderr.strip()[-200:]}): installing with pip --target")
             prefix = os.path.join(tmp, "target")
-            install = [sys.executable, "-m", "pip", "install", "--target", prefix]
+            install = [sys.executable, "-m", "pip", "install", "--no-deps", "--target", prefix]
             python = sys.executable
             run_env = dict(os.environ, PYTHONPATH=prefix)
         command = [*install, "--no-build-isolation", "--no-index", "--quiet",
