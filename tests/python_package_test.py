@@ -415,7 +415,7 @@ def test_curve():
                     pass
 
 
-def test_local_daemon_not_found():
+def test_local_daemon_errors():
     from leaflux import DaemonStartError, LocalDaemon
     missing = os.path.join(tempfile.gettempdir(), "no-such-dir", "leafluxd")
     try:
@@ -423,6 +423,15 @@ def test_local_daemon_not_found():
         raise AssertionError("a LocalDaemon of a missing leafluxd started")
     except DaemonStartError as e:
         assert missing in str(e), e
+    with socket.socket() as busy:  # a port in use: leafluxd's own sentence
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        try:
+            daemon(port=port)
+            raise AssertionError(f"a LocalDaemon on the busy port {port} started")
+        except DaemonStartError as e:
+            assert f"tcp://127.0.0.1:{port}" in str(e) and "in use" in str(e), e
 
 
 TESTS = [v for k, v in list(globals().items()) if k.startswith("test_")]

@@ -85,15 +85,18 @@ class LocalDaemon:
             command += ["--solver-threads", str(solver_threads)]
         self.command = command
         self.endpoint = ""
+        # The log may hold an earlier run's lines: only what this one appends is read.
+        self._log_start = os.path.getsize(self.log_file) if os.path.exists(self.log_file) else 0
+        self._stderr = tempfile.TemporaryFile(mode="w+")  # errors before the log opens
         self._process: Optional[subprocess.Popen] = subprocess.Popen(
-            command, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL)
+            command, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=self._stderr)
         try:
             self._wait_until_serving(start_timeout_s)
         except BaseException:
             self._process.kill()
             self._process.wait()
             self._process = None
+            self._stderr.close()
             raise
 
     @property
@@ -101,12 +104,17 @@ class LocalDaemon:
         return self._process.pid if self._process else 0
 
     def log(self) -> str:
-        """The daemon's log so far."""
+        """The daemon's log so far (what it wrote to the log file in this run)."""
         try:
             with open(self.log_file) as f:
+                f.seek(self._log_start)
                 return f.read()
         except OSError:
             return ""
+
+    def _errors(self) -> str:
+        self._stderr.seek(0)
+        return (self._stderr.read().strip() or self.log().strip())[-2000:]
 
     def _wait_until_serving(self, timeout_s: float) -> None:
         assert self._process is not None
@@ -139,7 +147,7 @@ class LocalDaemon:
         code = self._process.poll()
         if code is not None:
             raise DaemonStartError(f"leaflux: {' '.join(self.command)} exited with {code}:\n"
-                                   f"{self.log()[-2000:]}")
+                                   f"{self._errors()}")
 
     def stop(self) -> int:
         """SIGTERM, then waits stop_timeout_s (SIGKILL after it); returns the exit code."""
@@ -153,6 +161,7 @@ class LocalDaemon:
             except subprocess.TimeoutExpired:
                 process.kill()
                 process.wait()
+        self._stderr.close()
         if self._own_log:
             try:
                 os.unlink(self.log_file)

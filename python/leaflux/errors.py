@@ -100,6 +100,9 @@ class DaemonStartError(LeafluxError, RuntimeError):
     def __init__(self, message: str) -> None:
         super().__init__("ERROR_CODE_IO", message)
 
+    def __str__(self) -> str:
+        return self.message
+
 
 ERROR_CLASSES: Dict[str, Type[DaemonError]] = {
     "ERROR_CODE_INVALID_ARGUMENT": InvalidArgument,
