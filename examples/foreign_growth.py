@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Coupling a foreign growth model to leafluxd: a rosette written in a few lines of Python
 sends its own deltas and grows from the light it gets back.
 
@@ -100,13 +100,15 @@ def grow(client, cycles, settings, csv=None):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--endpoint")
-    parser.add_argument("--cycles", type=int, default=12)
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
+    parser.add_argument("--endpoint", help="a running leafluxd, e.g. tcp://127.0.0.1:5555 "
+                        "(default: start one, $LEAFLUX_BUILD/server/leafluxd or on PATH)")
+    parser.add_argument("--cycles", type=int, default=12, help="cycles to grow (default 12)")
     parser.add_argument("--samples", type=int, help="Monte Carlo paths per leaf (default: HRC)")
     parser.add_argument("--cycle-timeout", type=float, default=60.0,
                         help="seconds to wait for a cycle's light before resyncing (default 60)")
-    parser.add_argument("--csv", help="a row per cycle, at full precision")
+    parser.add_argument("--csv", help="write a row per cycle, at full precision, to this file "
+                        "(default: none)")
     args = parser.parse_args()
     settings = pb.SolverSettings(solver=pb.SOLVER_KIND_HRC, epsilon=1e-4)
     if args.samples:

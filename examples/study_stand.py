@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """A scripted study: a stand of plants (growth_stub/scenarios/stand.txtpb) grown by
 leaflux-grow at several spacings and row orientations; per plant, the PAR it absorbed over
 all cycles and its final biomass. Writes OUT/study.csv and OUT/study.png and prints the table.
@@ -42,12 +42,14 @@ def run(endpoint, out, spacing, azimuth, cycles):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("out")
-    parser.add_argument("--spacings", default="0.2,0.3,0.5")
-    parser.add_argument("--azimuths", default="0,90")
-    parser.add_argument("--cycles", type=int, default=12)
-    parser.add_argument("--endpoint")
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
+    parser.add_argument("out", help="folder of the runs, study.csv and study.png")
+    parser.add_argument("--spacings", default="0.2,0.3,0.5",
+                        help="plant spacings to grow, m, comma-separated (default 0.2,0.3,0.5)")
+    parser.add_argument("--azimuths", default="0,90",
+                        help="row azimuths, degrees, comma-separated (default 0,90)")
+    parser.add_argument("--cycles", type=int, default=12, help="cycles per run (default 12)")
+    parser.add_argument("--endpoint", help="a running leafluxd (default: start one)")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
     spacings = [float(s) for s in args.spacings.split(",")]

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""The Python client (examples/leaflux_client.py) when the daemon is slow or gone:
+"""The Python client (the package python/leaflux, through examples/leaflux_client.py) when
+the daemon is slow or gone:
 
 1. a timeout names the endpoint, and the late reply of the request given up on is never
    taken for the answer to the next one;
