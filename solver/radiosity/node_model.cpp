@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 
 #include "solver/util/check.h"
@@ -29,8 +30,29 @@ NodeModel::NodeModel(Hierarchy& hierarchy, const Scene& scene, const RayScene& r
     AssignSlots();
 }
 
-// Marks the clusters with an organ under them (a cluster's children come before it).
+// Marks the clusters with an organ under them (a cluster's children come before it), and
+// finds the organs' bounds and each triangle's depth of subdivision.
 void NodeModel::FindOrgans() {
+    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    for (const Triangle& t : flat_.triangles) {
+        if (flat_.receivers[t.receiver].kind != ReceiverKind::kOrgan) continue;
+        lo = glm::min(lo, glm::min(t.a, glm::min(t.b, t.c)));
+        hi = glm::max(hi, glm::max(t.a, glm::max(t.b, t.c)));
+    }
+    if (lo.x <= hi.x) {
+        organsCentre_ = 0.5 * (lo + hi);
+        organsRadius_ = 0.5 * glm::length(hi - lo);
+    }
+    constexpr int kMaxSurfaceDepth = 10;
+    maxDepth_.assign(flat_.triangles.size(), static_cast<std::uint8_t>(maxSubdivision_));
+    for (std::size_t i = 0; i < flat_.triangles.size() && organsRadius_ > 0.0; ++i) {
+        const Triangle& t = flat_.triangles[i];
+        if (flat_.receivers[t.receiver].kind == ReceiverKind::kOrgan) continue;
+        const double levels = std::ceil(std::log2(std::sqrt(2.0 * t.areaM2) / organsRadius_)) + 1;
+        maxDepth_[i] =
+            static_cast<std::uint8_t>(std::clamp(static_cast<int>(levels), maxSubdivision_,
+                                                 std::max(maxSubdivision_, kMaxSurfaceDepth)));
+    }
     organs_.assign(hierarchy_.Size(), 0);
     for (std::uint32_t n = 0; n < hierarchy_.Size(); ++n) {
         const HrcNode& node = hierarchy_[n];
@@ -189,11 +211,12 @@ bool NodeModel::CanSplit(std::uint32_t n) const {
     const HrcNode& node = hierarchy_[n];
     if (!node.children.empty()) return true;
     if (!node.patch) return false;  // a cluster without children has nothing to split into
-    return node.depth < maxSubdivision_ && node.areaM2 / 4.0 >= MinArea(node);
+    return node.depth < maxDepth_[node.triangle] && node.areaM2 / 4.0 >= MinArea(node);
 }
 
 double NodeModel::MinArea(const HrcNode& patch) const {
-    return std::ldexp(flat_.triangles[patch.triangle].areaM2, -2 * maxSubdivision_) * 0.999;
+    return std::ldexp(flat_.triangles[patch.triangle].areaM2, -2 * maxDepth_[patch.triangle]) *
+           0.999;
 }
 
 void NodeModel::Subdivide(std::uint32_t n) {

@@ -62,6 +62,24 @@ class NodeModel {
     // Whether a link into node r hands the same light to organs that may see it unevenly:
     // r is a cluster with organs under it (a closed instance is one).
     bool Shared(std::uint32_t r) const { return !hierarchy_[r].patch && organs_[r]; }
+    // n is an organ's patch, or a cluster with organs under it.
+    bool HoldsOrgans(std::uint32_t n) const {
+        const HrcNode& node = hierarchy_[n];
+        return node.patch ? flat_.receivers[node.receiver].kind == ReceiverKind::kOrgan
+                          : organs_[n] != 0;
+    }
+    // How much a node's own error matters to the organs, as a factor on its links'
+    // threshold: 1 for organs and what lies within the organs' bounding sphere's radius of
+    // them; beyond, 1 + (d / R)², d the gap between the node and that sphere of radius R,
+    // for what a surface sends the organs falls as the square of its distance. A 200 m
+    // ground is then fine under the canopy and coarse far from it.
+    double Importance(std::uint32_t n) const {
+        if (organsRadius_ <= 0.0 || HoldsOrgans(n)) return 1.0;
+        const HrcNode& node = hierarchy_[n];
+        const double gap =
+            std::max(0.0, glm::length(node.centre - organsCentre_) - organsRadius_ - node.radius);
+        return 1.0 + (gap / organsRadius_) * (gap / organsRadius_);
+    }
 
     // The side of patch p facing direction d of the set and p's lobe |n · ω| there, scaled
     // so that each side's interpolated lobe integrates to π (ScaleLobes).
@@ -130,6 +148,12 @@ class NodeModel {
     const Channels channels_;
     const int bins_;
     const int maxSubdivision_;
+    // The organs' bounding sphere (radius 0 without organs), and by flat triangle how many
+    // times it may be split in four: maxSubdivision_ for organs; for a surface enough to
+    // come down to the organs' size where it matters (Importance).
+    glm::dvec3 organsCentre_{0.0};
+    double organsRadius_ = 0.0;
+    std::vector<std::uint8_t> maxDepth_;
     std::vector<std::uint8_t> inner_;  // by flat triangle: bit s set when side s is inside
     std::vector<std::array<double, 2>> lobeScale_;  // by flat triangle and side: BinCosine
     std::vector<std::uint8_t> organs_;              // by node as built: 1 over an organ

@@ -123,7 +123,8 @@ Refiner::Verdict Refiner::JudgeSource(std::uint32_t r, std::uint32_t s) const {
 
 double Refiner::SourceThreshold(std::uint32_t r) const {
     const auto sources = static_cast<double>(std::max<std::size_t>(thresholds_.sourceCount, 1));
-    return model_.Shared(r) ? thresholds_.errorW / std::sqrt(sources) : thresholds_.errorW;
+    return model_.Importance(r) *
+           (model_.Shared(r) ? thresholds_.errorW / std::sqrt(sources) : thresholds_.errorW);
 }
 
 Refiner::Verdict::Kind Refiner::SplitChoice(std::uint32_t r, std::uint32_t s) const {

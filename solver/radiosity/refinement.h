@@ -78,8 +78,9 @@ class Refiner {
 
     // The error a link into node r may carry (W), from a node or from a directional source.
     double Threshold(std::uint32_t r) const {
-        return model_.Shared(r) ? thresholds_.errorW * thresholds_.clusterTolerance
-                                : thresholds_.errorW;
+        return model_.Importance(r) * (model_.Shared(r)
+                                           ? thresholds_.errorW * thresholds_.clusterTolerance
+                                           : thresholds_.errorW);
     }
     double SourceThreshold(std::uint32_t r) const;
 
