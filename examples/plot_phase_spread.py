@@ -37,7 +37,7 @@ def main():
         raise SystemExit(f"{args.slices} has no rows of band {args.band}")
 
     types = sorted({s.split("|")[0] for s in curves})
-    fig, axes = plt.subplots(1, len(types), figsize=(6.5 * len(types), 5), squeeze=False)
+    fig, axes = plt.subplots(1, len(types), figsize=(6.5 * len(types), 6), squeeze=False)
     colours = plt.get_cmap("tab10")
     for ax, kind in zip(axes[0], types):
         groups = [s for s in curves if s.split("|")[0] == kind]
@@ -60,7 +60,7 @@ def main():
         ax.set_xticks(range(0, 361, 45))
         ax.set_ylim(bottom=0)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="upper right")
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
     fig.suptitle("Phase function slices within and across signatures (thick: representative, "
                  "thin: other members)", fontsize=10)
     fig.tight_layout()

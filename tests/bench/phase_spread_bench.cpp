@@ -6,7 +6,7 @@
 // Four generated trees (2,000 and 5,000 leaves, two seeds) in one scene, grouped by the
 // policy fitted to them. For each group of two or more, up to K members (the representative
 // and others spread over the group's leaf counts) are solved alone: τ at 130 directions and
-// f by radiosity (bi-directional, 34² or 130²). Per group and band:
+// f by radiosity (bi-directional, 130² by default). Per group and band:
 //   - the spread of τ and of f: the RMS over directions (pairs) of the members' standard
 //     deviation, in % of their mean;
 //   - the error of lending the representative's f to every other sampled member: the RMS of
@@ -14,12 +14,14 @@
 //     power per incoming direction and for the intercepted area (1 − τ)·A_box (τ alone
 //     depends on the box, the intercepted area does not), and for f per unit leaf area
 //     (its shape, whatever the size);
-//   - the same errors with the representative of the nearest other group of the same type.
+//   - the same errors with the representative of the nearest other group of the same type;
+//   - the part of τ's spread and of the intercepted area's error that the rays' noise alone
+//     would give (f by radiosity is deterministic but for its escape rays).
 // Directions are weighted by their hats' solid angles. Also writes the Fig. 8 slices of the
 // sampled members: f per unit leaf area from a lateral direction (θ = φ = π/2 in the
 // structure's frame) towards lateral outputs (θ = π/2, φ from 0 to 2π).
 // Run: build/release/tests/leaflux_bench_phase_spread [out dir, out/bench]
-//      [policy, proto/policies/generated_tree.txtpb] [members per group, 8] [f level, 2]
+//      [policy, proto/policies/generated_tree.txtpb] [members per group, 8] [f level, 3]
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -47,6 +49,9 @@ namespace leaflux {
 namespace {
 
 constexpr int kTauLevel = 3;
+// Rays per τ direction: at 4,096 the noise of a sparse crown's (1 − τ) is several percent,
+// as large as the spread to be measured.
+constexpr int kTauRays = 65536;
 constexpr int kSliceAngles = 72;
 
 struct TreeSpec {
@@ -75,8 +80,9 @@ struct Member {
     NodeId id = 0;
     std::int64_t leaves = 0;
     double leafAreaM2 = 0.0;
-    SphereFunction tau;
+    SphereFunction tau, tauError;       // τ and its standard error
     std::vector<double> interceptedM2;  // per τ direction: (1 − τ)·A_box
+    std::vector<double> interceptedErrorM2;
     PhaseFunction f;
     std::vector<double> scatteredW;  // per incoming direction and band
     double seconds = 0.0;
@@ -88,12 +94,15 @@ Member Solve(const Scene& scene, NodeId id, int level) {
     m.id = id;
     m.leaves = alone.LeafCount();
     m.leafAreaM2 = alone.LeafAreaM2();
-    const TransmittanceEstimate t = ComputeTransmittance(alone, {kTauLevel, 4096, 1});
+    const TransmittanceEstimate t = ComputeTransmittance(alone, {kTauLevel, kTauRays, 1});
     m.tau = t.tau;
+    m.tauError = t.standardError;
     const DirectionSet& set = m.tau.Directions();
-    for (int d = 0; d < set.Size(); ++d)
-        m.interceptedM2.push_back((1.0 - double(m.tau.At(d, 0))) *
-                                  alone.ProjectedArea(set.Direction(d)));
+    for (int d = 0; d < set.Size(); ++d) {
+        const double boxM2 = alone.ProjectedArea(set.Direction(d));
+        m.interceptedM2.push_back((1.0 - double(m.tau.At(d, 0))) * boxM2);
+        m.interceptedErrorM2.push_back(double(m.tauError.At(d, 0)) * boxM2);
+    }
     RadiosityPhaseOptions options;
     options.level = level;
     RadiosityPhase f = PhaseFromRadiosity(alone, options);
@@ -149,18 +158,45 @@ double ErrorPct(const Samples& s, const std::vector<double>& reference, std::siz
     return 100.0 * std::sqrt(sum / weights) / Mean(s);
 }
 
+// What the rays' noise alone makes of SpreadPct (`difference` false) or of ErrorPct with
+// the first member as reference (true): the RMS of the standard errors `errors`, of a
+// member's or of its difference with the reference, in % of the mean of `values`.
+double NoisePct(const Samples& errors, const Samples& values, bool difference) {
+    double sum = 0.0, weights = 0.0;
+    for (std::size_t m = difference ? 1 : 0; m < errors.rows.size(); ++m) {
+        for (std::size_t k = 0; k < errors.weights.size(); ++k) {
+            const double e = errors.rows[m][k], e0 = difference ? errors.rows[0][k] : 0.0;
+            sum += errors.weights[k] * (e * e + e0 * e0);
+            weights += errors.weights[k];
+        }
+    }
+    return 100.0 * std::sqrt(sum / weights) / Mean(values);
+}
+
 // The values of one quantity of a member.
-enum class Quantity { kTau, kIntercepted, kF, kFPerLeafArea, kScattered };
+enum class Quantity {
+    kTau,
+    kTauError,
+    kIntercepted,
+    kInterceptedError,
+    kF,
+    kFPerLeafArea,
+    kScattered
+};
 
 std::vector<double> Values(const Member& m, Quantity q, int band) {
     std::vector<double> v;
     const int bands = m.f.Bands();
     switch (q) {
         case Quantity::kTau:
-            for (float t : m.tau.Values()) v.push_back(t);
+        case Quantity::kTauError:
+            for (float t : (q == Quantity::kTau ? m.tau : m.tauError).Values()) v.push_back(t);
             break;
         case Quantity::kIntercepted:
             v = m.interceptedM2;
+            break;
+        case Quantity::kInterceptedError:
+            v = m.interceptedErrorM2;
             break;
         case Quantity::kF:
         case Quantity::kFPerLeafArea: {
@@ -178,7 +214,8 @@ std::vector<double> Values(const Member& m, Quantity q, int band) {
 }
 
 std::vector<double> Weights(const Member& m, Quantity q) {
-    const bool tau = q == Quantity::kTau || q == Quantity::kIntercepted;
+    const bool tau = q == Quantity::kTau || q == Quantity::kTauError ||
+                     q == Quantity::kIntercepted || q == Quantity::kInterceptedError;
     const DirectionSet& set = tau ? m.tau.Directions() : m.f.Directions();
     std::vector<double> w;
     if (q == Quantity::kF || q == Quantity::kFPerLeafArea) {
@@ -226,7 +263,8 @@ std::vector<NodeId> Sample(const SignatureGroup& group, const SceneSignatures& s
 }
 
 struct Row {
-    double tauSpread, fSpread, fRep, shapeRep, scatteredRep, interceptedRep;
+    double tauSpread, tauNoise, interceptedNoise, fSpread, fRep, shapeRep, scatteredRep,
+        interceptedRep;
     std::string other;  // the nearest other group of the same type; empty: none
     double fOther = 0.0, shapeOther = 0.0, scatteredOther = 0.0;
 };
@@ -239,6 +277,8 @@ Row Measure(const Group& g, const std::vector<Group>& groups, int band) {
                   scattered = Gather(ms, Quantity::kScattered, band),
                   intercepted = Gather(ms, Quantity::kIntercepted, band);
     r.tauSpread = SpreadPct(tau);
+    r.tauNoise = NoisePct(Gather(ms, Quantity::kTauError, band), tau, false);
+    r.interceptedNoise = NoisePct(Gather(ms, Quantity::kInterceptedError, band), intercepted, true);
     r.fSpread = SpreadPct(f);
     r.fRep = ErrorPct(f, f.rows[0], 0);
     r.shapeRep = ErrorPct(shape, shape.rows[0], 0);
@@ -261,6 +301,9 @@ Row Measure(const Group& g, const std::vector<Group>& groups, int band) {
     return r;
 }
 
+// A signature as a CSV field: its bins hold commas ("leaves[11,50)").
+std::string Quoted(const std::string& text) { return '"' + text + '"'; }
+
 void WriteSlices(const std::string& csv, const std::vector<Group>& groups,
                  const std::vector<Band>& bands) {
     std::FILE* out = std::fopen(csv.c_str(), "w");
@@ -275,8 +318,8 @@ void WriteSlices(const std::string& csv, const std::vector<Group>& groups,
                     const double phi = 2.0 * std::numbers::pi * a / kSliceAngles;
                     const glm::dvec3 outgoing{std::cos(phi), std::sin(phi), 0.0};
                     std::fprintf(out, "%s,%lld,%d,%lld,%.6g,%s,%.1f,%.6g\n",
-                                 g.signature->signature.c_str(), static_cast<long long>(m.id),
-                                 m.id == g.members.front().id ? 1 : 0,
+                                 Quoted(g.signature->signature).c_str(),
+                                 static_cast<long long>(m.id), m.id == g.members.front().id ? 1 : 0,
                                  static_cast<long long>(m.leaves), m.leafAreaM2,
                                  bands[b].name.c_str(), 360.0 * a / kSliceAngles,
                                  m.f.Value(b, towardSource, outgoing) / m.leafAreaM2);
@@ -314,19 +357,20 @@ void Run(const std::string& dir, const std::string& policyPath, std::size_t k, i
     const int directions = DirectionSet::OfLevel(level).Size();
     std::printf(
         "\nFunctions within a signature: %zu trees (%zu structures, %zu groups, %zu of "
-        "two or more), policy %s;\nτ at %d directions, f by radiosity at %d², up to %zu "
-        "members a group; errors in %% of the members' mean\n",
+        "two or more), policy %s;\nτ at %d directions (%d rays each), f by radiosity at %d², "
+        "up to %zu members a group; errors in %% of the members' mean\n",
         std::size(kTrees), signatures.structures.size(), signatures.groups.size(), groups.size(),
-        policy.species.c_str(), DirectionSet::OfLevel(kTauLevel).Size(), directions, k);
+        policy.species.c_str(), DirectionSet::OfLevel(kTauLevel).Size(), kTauRays, directions, k);
     std::FILE* out = std::fopen((dir + "/phase_spread.csv").c_str(), "w");
     std::fprintf(out,
                  "signature,members,sampled,min_leaves,max_leaves,representative,rep_leaves,"
-                 "band,tau_spread_pct,f_spread_pct,f_rep_error_pct,f_shape_rep_error_pct,"
-                 "scattered_rep_error_pct,intercepted_rep_error_pct,nearest_other,"
+                 "band,tau_spread_pct,tau_noise_pct,f_spread_pct,f_rep_error_pct,"
+                 "f_shape_rep_error_pct,scattered_rep_error_pct,intercepted_rep_error_pct,"
+                 "intercepted_noise_pct,nearest_other,"
                  "f_other_error_pct,f_shape_other_error_pct,scattered_other_error_pct\n");
-    std::printf("%-34s %9s %11s %7s %6s %6s %6s %6s %6s  %-34s %6s %6s\n", "signature", "members",
-                "leaves", "τ spr", "f spr", "f rep", "shape", "S rep", "A rep", "nearest other",
-                "f oth", "shape");
+    std::printf("%-34s %9s %11s %7s %6s %6s %6s %6s %6s %6s %6s  %-34s %6s %6s\n", "signature",
+                "members", "leaves", "τ spr", "noise", "f spr", "f rep", "shape", "S rep", "A rep",
+                "noise", "nearest other", "f oth", "shape");
     for (int band = 0; band < static_cast<int>(scene.bands.size()); ++band) {
         std::printf("%s\n", scene.bands[band].name.c_str());
         for (const Group& g : groups) {
@@ -335,19 +379,23 @@ void Run(const std::string& dir, const std::string& policyPath, std::size_t k, i
                                         std::to_string(g.signature->members.size());
             const std::string leaves =
                 std::to_string(g.minLeaves) + "-" + std::to_string(g.maxLeaves);
-            std::printf("%-34s %9s %11s %6.2f %6.2f %6.2f %6.2f %6.2f %6.2f  %-34s %6.1f %6.1f\n",
-                        g.signature->signature.c_str(), members.c_str(), leaves.c_str(),
-                        r.tauSpread, r.fSpread, r.fRep, r.shapeRep, r.scatteredRep,
-                        r.interceptedRep, r.other.empty() ? "–" : r.other.c_str(), r.fOther,
-                        r.shapeOther);
-            std::fprintf(out, "%s,%zu,%zu,%lld,%lld,%lld,%lld,%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%s,",
-                         g.signature->signature.c_str(), g.signature->members.size(),
-                         g.members.size(), static_cast<long long>(g.minLeaves),
-                         static_cast<long long>(g.maxLeaves),
-                         static_cast<long long>(g.members.front().id),
-                         static_cast<long long>(g.members.front().leaves),
-                         scene.bands[band].name.c_str(), r.tauSpread, r.fSpread, r.fRep, r.shapeRep,
-                         r.scatteredRep, r.interceptedRep, r.other.c_str());
+            std::printf(
+                "%-34s %9s %11s %6.2f %6.2f %6.2f %6.2f %6.2f %6.2f %6.2f %6.2f  %-34s %6.1f "
+                "%6.1f\n",
+                g.signature->signature.c_str(), members.c_str(), leaves.c_str(), r.tauSpread,
+                r.tauNoise, r.fSpread, r.fRep, r.shapeRep, r.scatteredRep, r.interceptedRep,
+                r.interceptedNoise, r.other.empty() ? "–" : r.other.c_str(), r.fOther,
+                r.shapeOther);
+            std::fprintf(
+                out,
+                "%s,%zu,%zu,%lld,%lld,%lld,%lld,%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,"
+                "%s,",
+                Quoted(g.signature->signature).c_str(), g.signature->members.size(),
+                g.members.size(), static_cast<long long>(g.minLeaves),
+                static_cast<long long>(g.maxLeaves), static_cast<long long>(g.members.front().id),
+                static_cast<long long>(g.members.front().leaves), scene.bands[band].name.c_str(),
+                r.tauSpread, r.tauNoise, r.fSpread, r.fRep, r.shapeRep, r.scatteredRep,
+                r.interceptedRep, r.interceptedNoise, Quoted(r.other).c_str());
             if (r.other.empty())
                 std::fprintf(out, ",,\n");
             else
@@ -368,7 +416,7 @@ int main(int argc, char** argv) {
     const std::string dir = argc > 1 ? argv[1] : "out/bench";
     const std::string policy = argc > 2 ? argv[2] : LEAFLUX_DEFAULT_POLICY;
     const int k = argc > 3 ? std::atoi(argv[3]) : 8;
-    const int level = argc > 4 ? std::atoi(argv[4]) : 2;
+    const int level = argc > 4 ? std::atoi(argv[4]) : 3;
     if (k < 2 || level < 0 || level > 4) {
         std::fprintf(stderr, "members per group must be ≥ 2 and the level 0..4\n");
         return 2;
