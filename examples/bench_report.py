@@ -225,10 +225,13 @@ def phase_spread_section(build, out, run=True):
              "| signature | members solved / in group | leaves | τ spread % (noise) | f spread % | f rep. error % | "
              "f/leaf area rep. error % | scattered rep. error % | intercepted rep. error % (noise) | nearest other group | "
              "f error with its rep. % | f/leaf area error with its rep. % |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    cell = lambda signature: signature.replace("|", "\\|")  # a signature's parts are split by |
     for r in rows:
-        other = (f"{r['nearest_other']} | {number(r['f_other_error_pct'])} | {number(r['f_shape_other_error_pct'])}"
-                 if r["nearest_other"] else "– | – | –")
-        table.append(f"| {r['signature']} | {r['sampled']} / {r['members']} | {r['min_leaves']}–{r['max_leaves']} | "
+        other = (f"{cell(r['nearest_other'])} | {number(r['f_other_error_pct'])} | "
+                 f"{number(r['f_shape_other_error_pct'])}" if r["nearest_other"] else "– | – | –")
+        leaves = (f"{int(r['min_leaves']):,}" if r["min_leaves"] == r["max_leaves"]
+                  else f"{int(r['min_leaves']):,}–{int(r['max_leaves']):,}")
+        table.append(f"| {cell(r['signature'])} | {r['sampled']} / {int(r['members']):,} | {leaves} | "
                      f"{number(r['tau_spread_pct'])} ({number(r['tau_noise_pct'])}) | {number(r['f_spread_pct'])} | {number(r['f_rep_error_pct'])} | "
                      f"{number(r['f_shape_rep_error_pct'])} | {number(r['scattered_rep_error_pct'])} | "
                      f"{number(r['intercepted_rep_error_pct'])} ({number(r['intercepted_noise_pct'])}) | {other} |")
