@@ -1,13 +1,14 @@
 #!/usr/bin/env python3
 """The evaluation behind docs/results.md and the README's summary table.
 
-Error against run time on the benchmark scenes (`leaflux bench error`), time and memory against size (bench_scaling.py), and the growth of
-the demo. Copies CSVs and plots to examples/report/, then writes each table from those CSVs
+Error against run time on the benchmark scenes (`leaflux bench error`), time and memory against size (bench_scaling.py), the growth of
+the demo, and the spread of phase functions within a signature (leaflux_bench_phase_spread).
+Copies CSVs and plots to examples/report/, then writes each table from those CSVs
 between its `<!-- report:NAME -->` and `<!-- /report:NAME -->` markers, so that the docs say
 what the last run measured and nothing else: docs/results.md holds every table (one section
 per scene), README.md one summary of the error tables (`report:summary`).
 
-Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,scaling,phase,growth] [--scenes a,b]
+Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,scaling,phase,phase-spread,growth] [--scenes a,b]
                       [--scaling-solvers hrc,mc]
        bench_report.py --tables-only [--only ...]   # rewrite from examples/report/, run nothing
 The growth part reads the demo's out/demo/ (run scripts/demo.sh first).
@@ -230,13 +231,42 @@ def phase_sections(build, out, run=True):
     return "\n".join(table), "\n".join(times)
 
 
+def phase_spread_section(build, out, run=True):
+    """Runs leaflux_bench_phase_spread (the fitted policy on four generated trees) and plots
+    its Fig. 8 slices into examples/report/; returns the NIR table for docs/results.md."""
+    if run:
+        os.makedirs(out, exist_ok=True)
+        subprocess.run([os.path.join(build, "tests", "leaflux_bench_phase_spread"), out], check=True)  # minutes
+        for name in ("phase_spread.csv", "phase_slices.csv"):
+            shutil.copy(os.path.join(out, name), os.path.join(REPORT, name))
+        subprocess.run([sys.executable, os.path.join(HERE, "plot_phase_spread.py"),
+                        os.path.join(REPORT, "phase_slices.csv"), os.path.join(REPORT, "phase_slices.png")],
+                       check=True)
+    rows = [r for r in csv.DictReader(open(os.path.join(REPORT, "phase_spread.csv"))) if r["band"] == "NIR"]
+    table = [f"![phase slices]({figure(RESULTS, 'phase_slices.png')})", "",
+             "| signature | members solved / in group | leaves | τ spread % (noise) | f spread % | f rep. error % | "
+             "f/leaf area rep. error % | scattered rep. error % | intercepted rep. error % (noise) | nearest other group | "
+             "f error with its rep. % | f/leaf area error with its rep. % |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    cell = lambda signature: signature.replace("|", "\\|")  # a signature's parts are split by |
+    for r in rows:
+        other = (f"{cell(r['nearest_other'])} | {number(r['f_other_error_pct'])} | "
+                 f"{number(r['f_shape_other_error_pct'])}" if r["nearest_other"] else "– | – | –")
+        leaves = (f"{int(r['min_leaves']):,}" if r["min_leaves"] == r["max_leaves"]
+                  else f"{int(r['min_leaves']):,}–{int(r['max_leaves']):,}")
+        table.append(f"| {cell(r['signature'])} | {r['sampled']} / {int(r['members']):,} | {leaves} | "
+                     f"{number(r['tau_spread_pct'])} ({number(r['tau_noise_pct'])}) | {number(r['f_spread_pct'])} | {number(r['f_rep_error_pct'])} | "
+                     f"{number(r['f_shape_rep_error_pct'])} | {number(r['scattered_rep_error_pct'])} | "
+                     f"{number(r['intercepted_rep_error_pct'])} ({number(r['intercepted_noise_pct'])}) | {other} |")
+    return "\n".join(table)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("build", nargs="?", default=os.path.join(ROOT, "build", "release"),
                         help="build directory (default: build/release)")
     parser.add_argument("out", nargs="?", default=os.path.join(ROOT, "out", "report"),
                         help="directory of the runs' files (default: out/report)")
-    parser.add_argument("--only", default="error,scaling,phase,growth",
+    parser.add_argument("--only", default="error,scaling,phase,phase-spread,growth",
                         help="parts to run (default: all)")
     parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
     parser.add_argument("--scaling-solvers", default="hrc,mc",
@@ -265,6 +295,8 @@ def main():
     if "growth" in parts:
         update(RESULTS, "growth", growth_section(args.demo, run))
         update(RESULTS, "demo", demo_section())
+    if "phase-spread" in parts:
+        update(RESULTS, "phase-spread", phase_spread_section(build, os.path.join(out, "phase_spread"), run))
     print(f"sections {args.only} rewritten in docs/results.md"
           f"{' and the summary in README.md' if 'error' in parts else ''}; files in {REPORT}")
 

@@ -19,26 +19,14 @@
 #include <unordered_map>
 #include <vector>
 
-#include "solver/generate/generator.h"
 #include "solver/instancing/phase_photons.h"
 #include "solver/instancing/phase_radiosity.h"
 #include "solver/instancing/structure.h"
 #include "solver/instancing/transmittance.h"
+#include "tests/bench/bench_trees.h"
 
 namespace leaflux {
 namespace {
-
-Scene Tree(int leaves, std::uint64_t seed = 1) {
-    Scene scene;
-    scene.bands = {{"PAR"}, {"NIR"}};
-    scene.optics = {{"leaf", {{0.08, 0.06, 0.05, 0.05}, {0.45, 0.4, 0.45, 0.45}}},
-                    {"stem", {{0.1, 0.1, 0.0, 0.0}, {0.3, 0.3, 0.0, 0.0}}}};
-    TreeParameters tree;
-    tree.leafCount = leaves;
-    tree.seed = seed;
-    AddTree(scene, tree, {0, 0, 0});
-    return scene;
-}
 
 struct Kind {
     const char* name;
