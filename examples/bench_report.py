@@ -8,7 +8,7 @@ between its `<!-- report:NAME -->` and `<!-- /report:NAME -->` markers, so that 
 what the last run measured and nothing else: docs/results.md holds every table (one section
 per scene), README.md one summary of the error tables (`report:summary`).
 
-Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,scaling,phase,phase-spread,growth] [--scenes a,b]
+Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,scaling,phase,phase-db,phase-spread,growth] [--scenes a,b]
                       [--scaling-solvers hrc,mc]
        bench_report.py --tables-only [--only ...]   # rewrite from examples/report/, run nothing
 The growth part reads the demo's out/demo/ (run scripts/demo.sh first).
@@ -231,6 +231,25 @@ def phase_sections(build, out, run=True):
     return "\n".join(table), "\n".join(times)
 
 
+def phase_db_section(build, out, run=True):
+    """Runs leaflux_bench_phase_db: the database's miss, hit and load times and its size on
+    disk against the number of functions it holds."""
+    if run:
+        os.makedirs(out, exist_ok=True)
+        subprocess.run([os.path.join(build, "tests", "leaflux_bench_phase_db"),
+                        os.path.join(out, "phase_db.csv")], check=True)
+        shutil.copy(os.path.join(out, "phase_db.csv"), os.path.join(REPORT, "phase_db.csv"))
+    rows = list(csv.DictReader(open(os.path.join(REPORT, "phase_db.csv"))))
+    table = ["| function | functions | blob kB | miss + store ms | memory hit µs | disk hit ms | "
+             "file MB | compacted MB |", "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        kind = "bi 130² × 2 bands" if r["kind"] == "bi" else "mono 130 × 2 bands"
+        table.append(f"| {kind} | {int(r['functions']):,} | {number(int(r['blob_bytes']) / 1000)} | "
+                     f"{number(r['miss_store_ms'])} | {number(r['memory_hit_us'])} | "
+                     f"{number(r['disk_hit_ms'])} | {number(r['file_mb'])} | {number(r['compacted_mb'])} |")
+    return "\n".join(table)
+
+
 def phase_spread_section(build, out, run=True):
     """Runs leaflux_bench_phase_spread (the fitted policy on four generated trees) and plots
     its Fig. 8 slices into examples/report/; returns the NIR table for docs/results.md."""
@@ -266,7 +285,7 @@ def main():
                         help="build directory (default: build/release)")
     parser.add_argument("out", nargs="?", default=os.path.join(ROOT, "out", "report"),
                         help="directory of the runs' files (default: out/report)")
-    parser.add_argument("--only", default="error,scaling,phase,phase-spread,growth",
+    parser.add_argument("--only", default="error,scaling,phase,phase-db,phase-spread,growth",
                         help="parts to run (default: all)")
     parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
     parser.add_argument("--scaling-solvers", default="hrc,mc",
@@ -295,6 +314,8 @@ def main():
     if "growth" in parts:
         update(RESULTS, "growth", growth_section(args.demo, run))
         update(RESULTS, "demo", demo_section())
+    if "phase-db" in parts:
+        update(RESULTS, "phase-db", phase_db_section(build, os.path.join(out, "phase"), run))
     if "phase-spread" in parts:
         update(RESULTS, "phase-spread", phase_spread_section(build, os.path.join(out, "phase_spread"), run))
     print(f"sections {args.only} rewritten in docs/results.md"

@@ -308,7 +308,9 @@ int main(int argc, char** argv) {
     solveApp
         ->add_option(
             "--epsilon", solve.epsilon,
-            "hrc: largest error of a link, as a fraction of the power the sources bring in")
+            "hrc: largest error of a link, as a fraction of the power the suns and sky bring "
+            "onto the organs (plus the lamps' power); surfaces far from the organs are "
+            "allowed more by the square of their distance")
         ->check(CLI::Range(1e-9, 1.0));
     AddHrcSettings(*solveApp, solve.hrc, "--", "hrc: ");
     solveApp->add_flag("--audit-links", solve.hrc.auditLinks,
@@ -432,7 +434,8 @@ int main(int argc, char** argv) {
     openApp->add_option("--solver", client.solver, "hrc or mc")
         ->check(CLI::IsMember({"mc", "hrc"}));
     openApp->add_flag("--strict", client.strict, kStrictHelp);
-    openApp->add_option("--epsilon", client.epsilon, "hrc: link error bound")
+    openApp->add_option("--epsilon", client.epsilon,
+                        "hrc: link error bound, a fraction of the power reaching the organs")
         ->check(CLI::Range(1e-9, 1.0));
     CLI::App* cycleApp = clientApp->add_subcommand("cycle", "Send a cycle, with a delta file");
     cycleApp->add_option("--session", client.session, "Session id")->required();

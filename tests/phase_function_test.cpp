@@ -307,11 +307,6 @@ TEST(PhaseFunction, FunctionsAreInvariantUnderRigidMotion) {
     EXPECT_LT(sum / (n * n), 1.3);
 }
 
-}  // namespace
-}  // namespace leaflux
-
-namespace leaflux {
-namespace {
 
 TEST(PhaseFromRadiosity, ASingleLeafIsItsClosedFormAtTheDirections) {
     const double side = 0.1, area = side * side;
@@ -334,12 +329,20 @@ TEST(PhaseFromRadiosity, ASingleLeafIsItsClosedFormAtTheDirections) {
     }
 }
 
+// 60 leaves whose τ is the same both ways, by radiosity on the 34 directions.
+RadiosityPhase CloudByRadiosity(const StructureAlone& cloud) {
+    RadiosityPhaseOptions options;
+    options.level = 2;
+    return PhaseFromRadiosity(cloud, options);
+}
+const Scene& ReciprocalCloud() {
+    static const Scene cloud = LeafCloud(60, 0.06, 0.3, 5, {0.45, 0.3, 0.35, 0.35});
+    return cloud;
+}
+
 TEST(PhaseFromRadiosity, AgreesWithPhotonsOnALeafCloud) {
-    const Scene scene = LeafCloud(60, 0.06, 0.3, 5, {0.45, 0.3, 0.35, 0.35});
-    const StructureAlone cloud(scene, 1);
-    RadiosityPhaseOptions hrOptions;
-    hrOptions.level = 2;
-    const RadiosityPhase hr = PhaseFromRadiosity(cloud, hrOptions);
+    const StructureAlone cloud(ReciprocalCloud(), 1);
+    const RadiosityPhase hr = CloudByRadiosity(cloud);
     PhotonOptions photonOptions;
     photonOptions.level = 2;
     photonOptions.photonsPerBeam = 40000;
@@ -370,20 +373,12 @@ TEST(PhaseFromRadiosity, AgreesWithPhotonsOnALeafCloud) {
     EXPECT_LT(worst, 0.05);
 }
 
-}  // namespace
-}  // namespace leaflux
-
-namespace leaflux {
-namespace {
 
 TEST(PhaseFromRadiosity, EveryBeamClosesAndFIsNearlyReciprocal) {
     // What a beam brings the structure, (1 − τ) A, by rays, against what radiosity makes
     // of it: scattered out plus absorbed. And f(i, o) against f(o, i).
-    const Scene scene = LeafCloud(60, 0.06, 0.3, 5, {0.45, 0.3, 0.35, 0.35});
-    const StructureAlone cloud(scene, 1);
-    RadiosityPhaseOptions options;
-    options.level = 2;
-    const RadiosityPhase hr = PhaseFromRadiosity(cloud, options);
+    const StructureAlone cloud(ReciprocalCloud(), 1);
+    const RadiosityPhase hr = CloudByRadiosity(cloud);
     TransmittanceOptions tauOptions;
     tauOptions.level = 2;
     tauOptions.raysPerDirection = 65536;

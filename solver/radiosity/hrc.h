@@ -18,8 +18,10 @@
 // Refinement: a link is split (the larger node, or a patch subdivided into four) while its
 // estimated error — the power it carries times its geometric error ((r_R + r_S)/d)² plus its
 // visibility spread 2√(v(1−v)), v the fraction of its rays that pass — exceeds ε times the power
-// the sources bring into the scene (less for links into clusters of organs: from the suns and sky
-// cones ε / √(their number), from surfaces HrcOptions::clusterTolerance); the candidate links are
+// the suns and sky cones bring onto the organs (and the lamps' power; less for links into
+// clusters of organs: from the suns and sky cones ε / √(their number), from surfaces
+// HrcOptions::clusterTolerance; more for links into surfaces far from the organs,
+// NodeModel::Importance); the candidate links are
 // judged in parallel chunks and the verdicts carried out in order, so the links do not depend on
 // the number of threads. A link kept only because its rays agreed takes its transfer from rays of
 // its own, so that the choice of links does not bias the light they carry. Solution: Jacobi
@@ -49,7 +51,9 @@
 namespace leaflux {
 
 struct HrcOptions {
-    // Largest error a link may carry, as a fraction of the power the sources bring in.
+    // Largest error a link may carry, as a fraction of the power the suns and sky cones
+    // bring onto the organs, unoccluded (and the lamps' power): a leaf's accuracy does not
+    // depend on the ground or walls around it.
     double epsilon = 1e-4;
     // A link into a cluster of organs hands every organ under it the cluster's mean light:
     // one hidden in the cluster gets too much from every such link, an exposed one too

@@ -54,14 +54,14 @@ void Timing(const std::string& csv, int photons) {
         "\nTime to compute a structure's functions (%d photons a beam, 4096 rays a τ "
         "direction)\n",
         photons);
-    std::printf("%7s %9s  %-10s %10s %11s %9s %10s\n", "leaves", "triangles", "function",
+    std::printf("%7s %9s  %-20s %10s %11s %9s %10s\n", "leaves", "triangles", "function",
                 "directions", "rays", "seconds", "kB");
     for (int leaves : {10, 100, 1000}) {
         const Scene scene = Tree(leaves);
         const StructureAlone tree(scene, scene.nodes.front().id);
         const auto row = [&](const char* function, int directions, std::int64_t rays,
                              double seconds, double kB) {
-            std::printf("%7lld %9zu  %-10s %10d %11lld %9.3f %10.3f\n",
+            std::printf("%7lld %9zu  %-20s %10d %11lld %9.3f %10.3f\n",
                         static_cast<long long>(tree.LeafCount()), tree.Flat().triangles.size(),
                         function, directions, static_cast<long long>(rays), seconds, kB);
             std::fprintf(out, "%lld,%zu,%s,%d,%lld,%.4f,%.3f\n",
@@ -75,7 +75,20 @@ void Timing(const std::string& csv, int photons) {
         }
         for (const Kind& kind : kKinds) {
             const PhaseEstimate f = Compute(tree, kind, photons);
-            row(kind.name, DirectionSet::OfLevel(kind.level).Size(), f.rays, f.seconds,
+            row((std::string(kind.name) + " photons").c_str(),
+                DirectionSet::OfLevel(kind.level).Size(), f.rays, f.seconds,
+                f.phase.Bytes() / 1000.0);
+        }
+        // By radiosity, every beam a channel of one solve: 514² of 1,000 leaves is 1,028
+        // channels on every link, past what this table should wait for.
+        for (int level : {2, 3, 4}) {
+            if (level == 4 && tree.LeafCount() > 100) continue;
+            RadiosityPhaseOptions options;
+            options.level = level;
+            const RadiosityPhase f = PhaseFromRadiosity(tree, options);
+            const char* name = level == 2 ? "bi 34² radiosity"
+                                          : level == 3 ? "bi 130² radiosity" : "bi 514² radiosity";
+            row(name, DirectionSet::OfLevel(level).Size(), f.stats.rays + f.escapeRays, f.seconds,
                 f.phase.Bytes() / 1000.0);
         }
     }
