@@ -15,8 +15,7 @@ public final class RequestTimeoutException extends LeafluxException {
 
     public RequestTimeoutException(String endpoint, String kind, long timeoutMs) {
         super(ErrorCode.ERROR_CODE_IO,
-              "no reply to " + kind + " from leafluxd at " + endpoint + " within " + timeoutMs
-                      + " ms (is it running there?)",
+              "no reply to " + kind + " within " + timeoutMs + " ms; is leafluxd running there?",
               kind, 0, endpoint);
         this.kind = kind;
         this.timeoutMs = timeoutMs;
