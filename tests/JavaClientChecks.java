@@ -28,6 +28,8 @@ import org.leaflux.v1.TopologyDelta;
 import org.leaflux.v1.Vec3;
 
 public final class JavaClientChecks {
+    static String endpoint = "";
+
     static void fail(String message) {
         System.out.println("FAIL: " + message);
         System.exit(1);
@@ -48,20 +50,20 @@ public final class JavaClientChecks {
             if (e.code() != code) {
                 fail(what + ": expected " + code + ", got " + e.code());
             }
+            if (!e.endpoint().equals(endpoint) || !e.getMessage().contains(endpoint)) {
+                fail(what + ": the error does not name the endpoint " + endpoint);
+            }
             return e;
         }
         fail(what + ": expected " + code + ", got a reply");
         return null;
     }
 
-    static void errors(String endpoint) {
+    static void errors() {
         try (LeafluxClient client = new LeafluxClient(endpoint)) {
             LeafluxException e = expect(ErrorCode.ERROR_CODE_UNKNOWN_SESSION, "unknown session",
                     () -> client.cycle(cycle("0123456789abcdef0123456789abcdef", 1,
                                              TopologyDelta.getDefaultInstance())));
-            if (!e.endpoint().equals(endpoint) || !e.getMessage().contains(endpoint)) {
-                fail("the error does not name the endpoint " + endpoint);
-            }
             Scene.Builder scene = Scene.newBuilder()
                     .setVersion(ProtocolVersion.PROTOCOL_VERSION_CURRENT)
                     .addBands(Band.newBuilder().setName("PAR"))
@@ -95,7 +97,7 @@ public final class JavaClientChecks {
         }
     }
 
-    static void timeout(String endpoint, long ms) {
+    static void timeout(long ms) {
         try (LeafluxClient client = new LeafluxClient(endpoint, LeafluxClient.Timeouts.all(ms))) {
             for (int attempt = 1; attempt <= 2; attempt++) {  // the second on a new connection
                 long start = System.nanoTime();
@@ -104,9 +106,6 @@ public final class JavaClientChecks {
                 long waitedMs = (System.nanoTime() - start) / 1_000_000;
                 if (!(e instanceof RequestTimeoutException)) {
                     fail("not a RequestTimeoutException: " + e.getClass().getName());
-                }
-                if (!e.getMessage().contains(endpoint)) {
-                    fail("the timeout does not name the endpoint " + endpoint);
                 }
                 if (waitedMs < ms || waitedMs > ms + 2000) {
                     fail("the timeout of " + ms + " ms came after " + waitedMs + " ms");
@@ -117,10 +116,12 @@ public final class JavaClientChecks {
     }
 
     public static void main(String[] args) {
-        if (args.length >= 2 && args[0].equals("errors")) {
-            errors(args[1]);
+        if (args.length == 2 && args[0].equals("errors")) {
+            endpoint = args[1];
+            errors();
         } else if (args.length == 3 && args[0].equals("timeout")) {
-            timeout(args[1], Long.parseLong(args[2]));
+            endpoint = args[1];
+            timeout(Long.parseLong(args[2]));
         } else {
             System.err.println("usage: JavaClientChecks errors ENDPOINT | timeout ENDPOINT MS");
             System.exit(2);

@@ -54,7 +54,7 @@ awk '
     $1 ~ /^[0-9]+$/ {
         rows++
         if ($1 != rows) { print "cycle " $1 " in row " rows; bad = 1 }
-        if (!($4 + 0 > 0) || $4 ~ /nan|inf/) { print "cycle " $1 ": absorbed PAR " $4 " is not finite and positive"; bad = 1 }
+        if (!($4 + 0 > 0) || tolower($4) ~ /nan|inf/) { print "cycle " $1 ": absorbed PAR " $4 " is not finite and positive"; bad = 1 }
         if (rows > 1 && $2 + 0 <= leaves) { print "cycle " $1 ": " $2 " leaves after " leaves; bad = 1 }
         if (!($3 + 0 > 0 && $3 + 0 < 50)) { print "cycle " $1 ": leaf area " $3 " dm2 is not plausible"; bad = 1 }
         leaves = $2 + 0
