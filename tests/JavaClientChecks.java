@@ -4,6 +4,11 @@
 //   errors ENDPOINT   a cycle of a session never opened is refused ERROR_CODE_UNKNOWN_SESSION
 //                     (field "session"), and a cycle sent twice ERROR_CODE_INVALID_ARGUMENT
 //                     (field "number"), as LeafluxExceptions carrying the daemon's code;
+//                     A cycle given a resync source after its session was closed is
+//                     resynced and lit (ERROR_CODE_UNKNOWN_SESSION handled);
+//   stale             against a stand-in daemon (a jeromq ROUTER) that answers first with
+//                     another request's id and a frame that is no Reply: both are dropped
+//                     and the reply of the request's own id is taken;
 //   timeout ENDPOINT MS  against no daemon, a Status times out within MS (and not much
 //                     later) with a RequestTimeoutException naming ENDPOINT, and so does
 //                     the next request on the new connection.
@@ -21,11 +26,15 @@ import org.leaflux.v1.NodeType;
 import org.leaflux.v1.Optics;
 import org.leaflux.v1.Organ;
 import org.leaflux.v1.OutputRequest;
+import org.leaflux.v1.Reply;
+import org.leaflux.v1.Request;
+import org.leaflux.v1.StatusReply;
 import org.leaflux.v1.ProtocolVersion;
 import org.leaflux.v1.Scene;
 import org.leaflux.v1.Sun;
 import org.leaflux.v1.TopologyDelta;
 import org.leaflux.v1.Vec3;
+import org.zeromq.ZMQ;
 
 public final class JavaClientChecks {
     static String endpoint = "";
@@ -94,7 +103,68 @@ public final class JavaClientChecks {
             client.closeSession(session);
             expect(ErrorCode.ERROR_CODE_UNKNOWN_SESSION, "closed session",
                     () -> client.cycle(cycle(session, 2, TopologyDelta.getDefaultInstance())));
+            // With a resync source, the lost session is given back whole and the cycle lit.
+            Scene before = scene.addNodes(leaf).build();
+            int[] resyncs = {0};
+            light = client.cycle(cycle(session, 2, TopologyDelta.getDefaultInstance()), () -> {
+                resyncs[0]++;
+                return new LeafluxClient.SceneState(before, null);
+            });
+            if (resyncs[0] != 1 || light.getNumber() != 2 || light.getOrgansCount() != 1) {
+                fail("the resynced cycle: " + resyncs[0] + " resyncs, cycle " + light.getNumber()
+                        + ", " + light.getOrgansCount() + " organs");
+            }
+            System.out.println("resynced the closed session and lit cycle 2");
+            client.closeSession(session);
         }
+    }
+
+    /** A stand-in daemon: answers the first request with a stale reply, junk, then its own. */
+    static void stale() throws InterruptedException {
+        ZMQ.Context context = ZMQ.context(1);
+        ZMQ.Socket router = context.socket(ZMQ.ROUTER);
+        router.setLinger(0);
+        int port = router.bindToRandomPort("tcp://127.0.0.1");
+        endpoint = "tcp://127.0.0.1:" + port;
+        String[] problem = {null};
+        Thread server = new Thread(() -> {
+            try {
+                byte[] identity = router.recv(0);
+                byte[] delimiter = router.recv(0);
+                Request request = Request.parseFrom(router.recv(0));
+                if (delimiter.length != 0 || router.hasReceiveMore()) {
+                    problem[0] = "the request is not [delimiter, payload]";
+                }
+                long id = request.getRequestId();
+                Reply.Builder reply = Reply.newBuilder().setVersion(request.getVersion());
+                for (byte[] payload : new byte[][] {
+                        reply.setRequestId(id + 41).setStatus(StatusReply.newBuilder()
+                                .setSessionCount(41)).build().toByteArray(),
+                        {(byte) 0xff, (byte) 0xff, (byte) 0xff},
+                        reply.setRequestId(id).setStatus(StatusReply.newBuilder()
+                                .setSessionCount(7)).build().toByteArray()}) {
+                    router.sendMore(identity);
+                    router.sendMore(new byte[0]);
+                    router.send(payload, 0);
+                }
+            } catch (Exception e) {
+                problem[0] = e.toString();
+            }
+        });
+        server.start();
+        try (LeafluxClient client = new LeafluxClient(endpoint, LeafluxClient.Timeouts.all(10_000))) {
+            int sessions = client.status("").getSessionCount();
+            server.join();
+            if (problem[0] != null) {
+                fail("the stand-in daemon: " + problem[0]);
+            }
+            if (sessions != 7) {
+                fail("took the reply with session_count " + sessions + ", not the one of its id (7)");
+            }
+            System.out.println("dropped a stale reply and a non-Reply frame, took its own");
+        }
+        router.close();
+        context.term();
     }
 
     static void timeout(long ms) {
@@ -115,15 +185,17 @@ public final class JavaClientChecks {
         }
     }
 
-    public static void main(String[] args) {
+    public static void main(String[] args) throws InterruptedException {
         if (args.length == 2 && args[0].equals("errors")) {
             endpoint = args[1];
             errors();
+        } else if (args.length == 1 && args[0].equals("stale")) {
+            stale();
         } else if (args.length == 3 && args[0].equals("timeout")) {
             endpoint = args[1];
             timeout(Long.parseLong(args[2]));
         } else {
-            System.err.println("usage: JavaClientChecks errors ENDPOINT | timeout ENDPOINT MS");
+            System.err.println("usage: JavaClientChecks errors ENDPOINT | stale | timeout ENDPOINT MS");
             System.exit(2);
         }
         System.out.println("ok");

@@ -4,7 +4,9 @@
 #  - the example growth loop: exit code 0, every cycle's absorbed PAR finite and positive,
 #    the leaf count growing each cycle, a plausible leaf area (under 50 dm²);
 #  - typed errors: a cycle of an unknown session is ERROR_CODE_UNKNOWN_SESSION (field
-#    "session"), a cycle sent twice ERROR_CODE_INVALID_ARGUMENT (field "number");
+#    "session"), a cycle sent twice ERROR_CODE_INVALID_ARGUMENT (field "number"); a cycle
+#    given a resync source after its session was closed is resynced and lit;
+#  - a reply of another request's id, and a frame that is no Reply, dropped;
 #  - a timeout against no daemon, within its time and naming the endpoint.
 # Exits 77 (ctest SKIP_RETURN_CODE) when javac, jar, protoc or Debian's protobuf.jar and
 # jeromq.jar (libprotobuf-java, libjeromq-java) are missing.
@@ -70,6 +72,12 @@ java -cp "$classpath" "$source/tests/JavaClientChecks.java" errors "$endpoint" >
     2> "$out/errors.err" || fail "typed errors"
 cat "$out/errors.out"
 
+# Stale replies (another request's id, a frame that is no Reply) dropped, with a stand-in
+# daemon.
+java -cp "$classpath" "$source/tests/JavaClientChecks.java" stale > "$out/stale.out" \
+    2> "$out/stale.err" || fail "stale replies"
+cat "$out/stale.out"
+
 # A timeout with no daemon: the running one stopped, its port now free.
 kill "$daemon"
 wait "$daemon" 2> /dev/null || true
@@ -77,4 +85,4 @@ daemon=
 java -cp "$classpath" "$source/tests/JavaClientChecks.java" timeout "$endpoint" 1500 \
     > "$out/timeout.out" 2> "$out/timeout.err" || fail "the timeout"
 cat "$out/timeout.out"
-echo "the Java client grew a plant over 5 cycles, got typed errors and timed out naming $endpoint"
+echo "the Java client grew a plant over 5 cycles, got typed errors, resynced, dropped stale replies and timed out naming $endpoint"
