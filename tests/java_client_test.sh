@@ -6,6 +6,7 @@
 #  - typed errors: a cycle of an unknown session is ERROR_CODE_UNKNOWN_SESSION (field
 #    "session"), a cycle sent twice ERROR_CODE_INVALID_ARGUMENT (field "number"); a cycle
 #    given a resync source after its session was closed is resynced and lit;
+#  - the loop through a kill -9 of leafluxd and a restart: resynced, the same 8 cycles;
 #  - a reply of another request's id, and a frame that is no Reply, dropped;
 #  - a timeout against no daemon, within its time and naming the endpoint.
 # Exits 77 (ctest SKIP_RETURN_CODE) when javac, jar, protoc or Debian's protobuf.jar and
@@ -22,12 +23,12 @@ for j in protobuf.jar jeromq.jar; do
 done
 
 out=$(mktemp -d)
-daemon=
+daemon= grower=
 cleanup() {
-    if [ -n "$daemon" ]; then
-        kill "$daemon" 2> /dev/null || true
-        wait "$daemon" 2> /dev/null || true
-    fi
+    for p in $daemon $grower; do
+        kill "$p" 2> /dev/null || true
+        wait "$p" 2> /dev/null || true
+    done
     rm -rf "$out"
 }
 trap cleanup EXIT
@@ -37,16 +38,20 @@ fail() { echo "FAIL: $1"; for f in "$out"/*.out "$out"/*.err "$out"/*.log; do ec
 jar=$build/java/leaflux-client.jar
 classpath=$jar:$jars/protobuf.jar:$jars/jeromq.jar
 
-"$build/server/leafluxd" --bind "tcp://127.0.0.1:*" --solver-threads 1 --log-file "$out/daemon.log" \
-    2> /dev/null &
-daemon=$!
-endpoint=
-for _ in $(seq 250); do
-    endpoint=$(grep -o "serving tcp://[^ ]*" "$out/daemon.log" 2> /dev/null | cut -d' ' -f2) || true
-    [ -n "$endpoint" ] && break
-    sleep 0.02
-done
-[ -n "$endpoint" ] || fail "leafluxd did not start"
+# Starts leafluxd on `bind` (one thread a solve: the light is the same bit for bit in
+# every run) and sets `endpoint` from its log's first line.
+start_daemon() {  # bind, log
+    "$build/server/leafluxd" --bind "$1" --solver-threads 1 --log-file "$2" 2> /dev/null &
+    daemon=$!
+    endpoint=
+    for _ in $(seq 250); do
+        endpoint=$(grep -o "serving tcp://[^ ]*" "$2" 2> /dev/null | cut -d' ' -f2) || true
+        [ -n "$endpoint" ] && return 0
+        sleep 0.02
+    done
+    fail "leafluxd did not start on $1"
+}
+start_daemon "tcp://127.0.0.1:*" "$out/daemon.log"
 
 # The growth loop, 5 cycles.
 java -jar "$jar" --endpoint "$endpoint" --cycles 5 > "$out/growth.out" 2> "$out/growth.err" ||
@@ -67,6 +72,30 @@ awk '
     }' "$out/growth.out" > "$out/growth.check" || fail "the growth loop's output: $(cat "$out/growth.check")"
 grep -q "^closed session after 5 cycles" "$out/growth.out" || fail "the growth loop did not close its session"
 
+# Killed mid-growth (SIGKILL) and started again on the same port: the loop's cycle times
+# out, or finds its session unknown; the client reconnects, resyncs and sends it again,
+# and the loop ends as an uninterrupted run does.
+java -jar "$jar" --endpoint "$endpoint" --cycles 8 > "$out/reference.out" 2> "$out/reference.err" ||
+    fail "the uninterrupted 8-cycle growth loop exited $?"
+java -jar "$jar" --endpoint "$endpoint" --cycles 8 --cycle-timeout-ms 3000 > "$out/faulted.out" \
+    2> "$out/faulted.err" &
+grower=$!
+for _ in $(seq 3000); do
+    grep -q "^ *3 " "$out/faulted.out" 2> /dev/null && break
+    sleep 0.02
+done
+grep -q "^ *3 " "$out/faulted.out" || fail "the faulted growth loop did not reach cycle 3"
+kill -9 "$daemon"
+wait "$daemon" 2> /dev/null || true
+start_daemon "$endpoint" "$out/restarted.log"
+wait "$grower" || fail "the growth loop did not finish after the restart"
+grower=
+grep -q "resyncing" "$out/faulted.err" || fail "the growth loop did not resync: the kill missed"
+grep -m1 "resyncing" "$out/faulted.err"
+cmp -s "$out/reference.out" "$out/faulted.out" ||
+    { diff "$out/reference.out" "$out/faulted.out"; fail "the growth differs after the restart"; }
+echo "killed and restarted leafluxd mid-growth: the loop resynced, its 8 cycles as without"
+
 # Typed errors from the daemon.
 java -cp "$classpath" "$source/tests/JavaClientChecks.java" errors "$endpoint" > "$out/errors.out" \
     2> "$out/errors.err" || fail "typed errors"
@@ -85,4 +114,4 @@ daemon=
 java -cp "$classpath" "$source/tests/JavaClientChecks.java" timeout "$endpoint" 1500 \
     > "$out/timeout.out" 2> "$out/timeout.err" || fail "the timeout"
 cat "$out/timeout.out"
-echo "the Java client grew a plant over 5 cycles, got typed errors, resynced, dropped stale replies and timed out naming $endpoint"
+echo "the Java client grew a plant over 5 cycles and through a restart, got typed errors, resynced, dropped stale replies and timed out naming $endpoint"
