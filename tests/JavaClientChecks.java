@@ -16,8 +16,8 @@
 import org.leaflux.client.LeafluxClient;
 import org.leaflux.client.LeafluxException;
 import org.leaflux.client.RequestTimeoutException;
-import org.leaflux.v1.BandOptics;
 import org.leaflux.v1.Band;
+import org.leaflux.v1.BandOptics;
 import org.leaflux.v1.Cycle;
 import org.leaflux.v1.ErrorCode;
 import org.leaflux.v1.Mesh;

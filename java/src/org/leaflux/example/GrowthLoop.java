@@ -133,7 +133,6 @@ public final class GrowthLoop {
         double raise = Math.toRadians(LEAF_RAISE_DEG);
         double ca = Math.cos(azimuth), sa = Math.sin(azimuth);
         double cr = Math.cos(raise), sr = Math.sin(raise);
-        double l = length;
         // Rz(azimuth) · Ry(−raise), at the internode's top.
         Frame f = frame(ca * cr, -sa, -ca * sr, 0,
                         sa * cr, ca, -sa * sr, 0,
@@ -141,7 +140,8 @@ public final class GrowthLoop {
         return Node.newBuilder().setId(101 + 2L * k).setParent(100 + 2L * k)
                 .setType(NodeType.NODE_TYPE_LEAF).setName("leaf" + k).setFrame(f)
                 .setOrgan(Organ.newBuilder().setOptics("leaf").setMesh(quad(new double[] {
-                        0, 0, 0, l / 2, -l / 4, 0, l, 0, 0, l / 2, l / 4, 0})))
+                        0, 0, 0, length / 2, -length / 4, 0, length, 0, 0,
+                        length / 2, length / 4, 0})))
                 .build();
     }
 
