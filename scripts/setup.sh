@@ -13,6 +13,7 @@ packages=(
     libsqlite3-dev libcli11-dev libpugixml-dev
     python3 python3-zmq python3-protobuf python3-matplotlib python3-numpy
     python3-venv python3-pip python3-setuptools python3-pytest python3-pandas
+    default-jdk-headless libjeromq-java libprotobuf-java
 )
 
 missing=()
