@@ -172,17 +172,23 @@ std::vector<BadInput> BadInputs() {
          ErrorCode::kInvalidArgument,
          "suns[0].normal_irradiance[PAR]",
          {}},
-        // A leaf scaled far past the world's range: its corners out of range, whatever the
-        // scale (the frame itself is refused once its determinant overflows).
+        // A leaf scaled far past the world's range is refused for its coordinates, whatever
+        // the scale: never lit with overflowing areas.
         {"leaf scaled by 1e15",
-         [](Scene& s) { s.nodes[1].parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e15)); },
-         ErrorCode::kInvalidArgument, "organ.mesh.positions[0]", 2},
+         [](Scene& s) {
+             s.nodes[1].parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e15));
+         },
+         ErrorCode::kInvalidArgument, "organ.mesh.triangles[0]", 2},
         {"leaf scaled by 1e20",
-         [](Scene& s) { s.nodes[1].parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e20)); },
-         ErrorCode::kInvalidArgument, "organ.mesh.positions[0]", 2},
+         [](Scene& s) {
+             s.nodes[1].parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e20));
+         },
+         ErrorCode::kInvalidArgument, "organ.mesh.triangles[0]", 2},
         {"leaf scaled by 1e300",
-         [](Scene& s) { s.nodes[1].parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e300)); },
-         ErrorCode::kDegenerate, "frame", 2},
+         [](Scene& s) {
+             s.nodes[1].parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e300));
+         },
+         ErrorCode::kInvalidArgument, "organ.mesh.triangles[0]", 2},
         {"sun of 1e308 W/m²",
          [](Scene& s) { s.sources.suns[0].normalIrradianceWm2 = {1e308}; },
          ErrorCode::kInvalidArgument,
