@@ -117,8 +117,12 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
     }
     rays += static_cast<std::int64_t>(starts.size());
     double visible = 0.0, total = 0.0;
-    if (occlusion_.ProxyCount() == 0 && beam) {  // triangles alone, one direction: together
-        occlusion_.Triangles().Occluded(starts, light.toward, occluded);
+    if (occlusion_.ProxyCount() == 0) {  // triangles alone: traced together
+        if (beam) {
+            occlusion_.Triangles().Occluded(starts, light.toward, occluded);
+        } else {
+            occlusion_.Triangles().Occluded(starts, directions, occluded);
+        }
         for (std::size_t i = 0; i < starts.size(); ++i) {
             total += weights[i];
             if (!occluded[i]) visible += weights[i];
@@ -128,10 +132,8 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
     for (std::size_t i = 0; i < starts.size(); ++i) {
         const std::int32_t ends[2] = {closed[i], -1};
         total += weights[i];
-        visible += weights[i] * (occlusion_.ProxyCount() == 0
-                                     ? !occlusion_.Triangles().Occluded(starts[i], directions[i])
-                                     : occlusion_.Transmittance(starts[i], directions[i], INFINITY,
-                                                                Exclusion(ends)));
+        visible += weights[i] *
+                   occlusion_.Transmittance(starts[i], directions[i], INFINITY, Exclusion(ends));
     }
     return total > 0.0 ? visible / total : 0.0;
 }

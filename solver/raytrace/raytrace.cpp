@@ -267,19 +267,34 @@ RayHit RayScene::Trace(const RayStart& start, const glm::dvec3& direction) const
 
 void RayScene::Occluded(const std::vector<RayStart>& starts, const glm::dvec3& direction,
                         std::vector<std::uint8_t>& occluded) const {
+    OccludedAlong(starts, [&](std::size_t) -> const glm::dvec3& { return direction; }, true,
+                  occluded);
+}
+
+void RayScene::Occluded(const std::vector<RayStart>& starts,
+                        const std::vector<glm::dvec3>& directions,
+                        std::vector<std::uint8_t>& occluded) const {
+    OccludedAlong(starts, [&](std::size_t i) -> const glm::dvec3& { return directions[i]; },
+                  false, occluded);
+}
+
+template <class Direction>
+void RayScene::OccludedAlong(const std::vector<RayStart>& starts, const Direction& direction,
+                             bool coherent, std::vector<std::uint8_t>& occluded) const {
     occluded.resize(starts.size());
     if (periodic_) {
         for (std::size_t i = 0; i < starts.size(); ++i)
-            occluded[i] = Occluded(starts[i], direction);
+            occluded[i] = Occluded(starts[i], direction(i));
         return;
     }
     thread_local std::vector<RTCRay> rays;
     rays.clear();
-    for (const RayStart& start : starts) {
-        rays.push_back(EmbreeRay(start, direction, std::numeric_limits<double>::infinity()));
+    for (std::size_t i = 0; i < starts.size(); ++i) {
+        rays.push_back(
+            EmbreeRay(starts[i], direction(i), std::numeric_limits<double>::infinity()));
     }
     StartContext context = MakeContext(0);
-    context.context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    if (coherent) context.context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     rtcOccluded1M(top_, &context.context, rays.data(), static_cast<unsigned>(rays.size()),
                   sizeof(RTCRay));
     for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = rays[i].tfar < 0.0f;

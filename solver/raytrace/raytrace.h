@@ -83,6 +83,9 @@ class RayScene {
     // or sky cone), traced together: occluded[i] is 1 where ray i is blocked.
     void Occluded(const std::vector<RayStart>& starts, const glm::dvec3& direction,
                   std::vector<std::uint8_t>& occluded) const;
+    // The same with a direction per ray (the rays of a cone of light).
+    void Occluded(const std::vector<RayStart>& starts, const std::vector<glm::dvec3>& directions,
+                  std::vector<std::uint8_t>& occluded) const;
 
     // A group of triangles: those whose rank (an index by triangle) lies in [first, last).
     struct Group {
@@ -98,6 +101,9 @@ class RayScene {
     bool Periodic() const { return periodic_.has_value(); }
 
   private:
+    template <class Direction>
+    void OccludedAlong(const std::vector<RayStart>& starts, const Direction& direction,
+                       bool coherent, std::vector<std::uint8_t>& occluded) const;
     RayHit TraceOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const;
     bool OccludedOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const;
     // Wraps a start into the tile; returns the distance to the tile's side along direction.
