@@ -17,7 +17,8 @@ for _ in $(seq "$runs"); do
     done
 done
 for build in "$a" "$b"; do
-    grep -F "$build," "$tmp" | cut -d, -f2 | sort -g | awk -v build="$build" -v scene="$scene" \
+    # The build's own lines: one build's path may hold the other's.
+    awk -F, -v build="$build" '$1 == build { print $2 }' "$tmp" | sort -g | awk -v build="$build" -v scene="$scene" \
         -v args="$args" -v out="$out" '
         { t[NR] = $1; s += $1 }
         END {
