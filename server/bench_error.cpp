@@ -17,6 +17,7 @@
 #include "solver/solve.h"
 #include "solver/util/error.h"
 #include "solver/util/memory.h"
+#include "solver/util/user_directory.h"
 
 namespace leaflux {
 namespace {
@@ -278,13 +279,7 @@ void Plot(const ErrorBenchOptions& options) {
 }  // namespace
 
 std::string DefaultCacheDirectory() {
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) {
-        return std::string(xdg) + "/leaflux";
-    }
-    if (const char* home = std::getenv("HOME"); home && *home) {
-        return std::string(home) + "/.cache/leaflux";
-    }
-    return ".leaflux-cache";
+    return LeafluxDirectory("XDG_CACHE_HOME", ".cache", ".leaflux-cache");
 }
 
 int RunErrorBench(const ErrorBenchOptions& options) {

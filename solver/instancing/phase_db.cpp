@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "solver/instancing/original_codec.h"
+#include "solver/util/user_directory.h"
 
 namespace leaflux {
 namespace {
@@ -16,13 +17,7 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 std::string DefaultPhaseDatabasePath() {
-    if (const char* xdg = std::getenv("XDG_DATA_HOME"); xdg && *xdg) {
-        return std::string(xdg) + "/leaflux/phase.db";
-    }
-    if (const char* home = std::getenv("HOME"); home && *home) {
-        return std::string(home) + "/.local/share/leaflux/phase.db";
-    }
-    return "phase.db";
+    return LeafluxDirectory("XDG_DATA_HOME", ".local/share", ".") + "/phase.db";
 }
 
 const char* PhaseSourceName(PhaseSource source) {
