@@ -20,8 +20,8 @@
 
 #include "server/bench_error.h"
 #include "server/client.h"
-#include "server/policy_cli.h"
 #include "server/phase_db_cli.h"
+#include "server/policy_cli.h"
 #include "server/scene_proto.h"
 #include "solver/generate/generator.h"
 #include "solver/results/export.h"
@@ -434,8 +434,9 @@ int main(int argc, char** argv) {
     openApp->add_option("--solver", client.solver, "hrc or mc")
         ->check(CLI::IsMember({"mc", "hrc"}));
     openApp->add_flag("--strict", client.strict, kStrictHelp);
-    openApp->add_option("--epsilon", client.epsilon,
-                        "hrc: link error bound, a fraction of the power reaching the organs")
+    openApp
+        ->add_option("--epsilon", client.epsilon,
+                     "hrc: link error bound, a fraction of the power reaching the organs")
         ->check(CLI::Range(1e-9, 1.0));
     CLI::App* cycleApp = clientApp->add_subcommand("cycle", "Send a cycle, with a delta file");
     cycleApp->add_option("--session", client.session, "Session id")->required();

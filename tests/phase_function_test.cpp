@@ -69,6 +69,15 @@ std::vector<double> HatProjection(const DirectionSet& set, G g, int m = 400000) 
     return weighted;
 }
 
+// Photons on the 34 directions, in `replicates` groups for the standard errors.
+PhotonOptions OnTheTetrahedron34(int photonsPerBeam, int replicates) {
+    PhotonOptions options;
+    options.level = 2;
+    options.photonsPerBeam = photonsPerBeam;
+    options.replicates = replicates;
+    return options;
+}
+
 Scene SingleLeaf(double side, BandOptics optics) {
     Scene scene;
     scene.bands = {{"PAR"}};
@@ -84,10 +93,7 @@ TEST(PhaseFunction, ASingleTwoSidedLambertianLeafMatchesItsClosedForm) {
     const BandOptics optics{0.4, 0.3, 0.2, 0.1};  // ρ upper, ρ lower, τ upper→lower, lower→upper
     const Scene scene = SingleLeaf(side, optics);
     const StructureAlone leaf(scene, 1);
-    PhotonOptions options;
-    options.level = 2;
-    options.photonsPerBeam = 40000;
-    options.replicates = 32;
+    PhotonOptions options = OnTheTetrahedron34(40000, 32);
     const PhaseEstimate estimate = PhaseFromPhotons(leaf, options);
     const DirectionSet& set = estimate.phase.Directions();
     const auto up = HatProjection(set, [](const glm::dvec3& d) { return std::max(0.0, d.z); });
@@ -130,10 +136,7 @@ TEST(PhaseFunction, ASingleTwoSidedLambertianLeafMatchesItsClosedForm) {
 TEST(PhaseFunction, EveryBeamClosesScatteredPlusAbsorbedPlusTransmittedOnWhatEntered) {
     const Scene scene = LeafCloud(80, 0.06, 0.4, 11, {0.45, 0.35, 0.4, 0.4});
     const StructureAlone cloud(scene, 1);
-    PhotonOptions options;
-    options.level = 2;
-    options.photonsPerBeam = 20000;
-    options.replicates = 32;
+    PhotonOptions options = OnTheTetrahedron34(20000, 32);
     const PhaseEstimate estimate = PhaseFromPhotons(cloud, options);
     double worst = 0.0;
     for (std::size_t i = 0; i < estimate.beams.size(); ++i) {
@@ -173,10 +176,7 @@ double ReciprocityStatistic(const PhaseEstimate& estimate, double& worst) {
 }
 
 TEST(PhaseFunction, ReciprocityHoldsWithinTheStatedErrorAndTheTestSeesItBroken) {
-    PhotonOptions options;
-    options.level = 2;
-    options.photonsPerBeam = 20000;
-    options.replicates = 32;
+    PhotonOptions options = OnTheTetrahedron34(20000, 32);
     // Reflectances may differ between the sides; reciprocity needs τ the same both ways.
     const Scene reciprocal = LeafCloud(60, 0.06, 0.3, 5, {0.45, 0.3, 0.35, 0.35});
     double worst = 0.0;
@@ -247,10 +247,7 @@ TEST(Transmittance, ARandomLeafCloudFollowsTheGapFractionLaw) {
 }
 
 TEST(PhaseFunction, FunctionsAreInvariantUnderRigidMotion) {
-    PhotonOptions options;
-    options.level = 2;
-    options.photonsPerBeam = 10000;
-    options.replicates = 16;
+    PhotonOptions options = OnTheTetrahedron34(10000, 16);
     TransmittanceOptions tauOptions;
     tauOptions.level = 2;
     const BandOptics optics{0.45, 0.3, 0.35, 0.35};
@@ -307,7 +304,6 @@ TEST(PhaseFunction, FunctionsAreInvariantUnderRigidMotion) {
     EXPECT_LT(sum / (n * n), 1.3);
 }
 
-
 TEST(PhaseFromRadiosity, ASingleLeafIsItsClosedFormAtTheDirections) {
     const double side = 0.1, area = side * side;
     const BandOptics optics{0.4, 0.3, 0.2, 0.1};
@@ -343,10 +339,7 @@ const Scene& ReciprocalCloud() {
 TEST(PhaseFromRadiosity, AgreesWithPhotonsOnALeafCloud) {
     const StructureAlone cloud(ReciprocalCloud(), 1);
     const RadiosityPhase hr = CloudByRadiosity(cloud);
-    PhotonOptions photonOptions;
-    photonOptions.level = 2;
-    photonOptions.photonsPerBeam = 40000;
-    photonOptions.replicates = 32;
+    PhotonOptions photonOptions = OnTheTetrahedron34(40000, 32);
     photonOptions.hatIncoming = false;
     const PhaseEstimate photons = PhaseFromPhotons(cloud, photonOptions);
     const DirectionSet& set = hr.phase.Directions();
@@ -372,7 +365,6 @@ TEST(PhaseFromRadiosity, AgreesWithPhotonsOnALeafCloud) {
     EXPECT_LT(squares, 4.0);
     EXPECT_LT(worst, 0.05);
 }
-
 
 TEST(PhaseFromRadiosity, EveryBeamClosesAndFIsNearlyReciprocal) {
     // What a beam brings the structure, (1 − τ) A, by rays, against what radiosity makes

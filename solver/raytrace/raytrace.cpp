@@ -267,15 +267,15 @@ RayHit RayScene::Trace(const RayStart& start, const glm::dvec3& direction) const
 
 void RayScene::Occluded(const std::vector<RayStart>& starts, const glm::dvec3& direction,
                         std::vector<std::uint8_t>& occluded) const {
-    OccludedAlong(starts, [&](std::size_t) -> const glm::dvec3& { return direction; }, true,
-                  occluded);
+    OccludedAlong(
+        starts, [&](std::size_t) -> const glm::dvec3& { return direction; }, true, occluded);
 }
 
 void RayScene::Occluded(const std::vector<RayStart>& starts,
                         const std::vector<glm::dvec3>& directions,
                         std::vector<std::uint8_t>& occluded) const {
-    OccludedAlong(starts, [&](std::size_t i) -> const glm::dvec3& { return directions[i]; },
-                  false, occluded);
+    OccludedAlong(
+        starts, [&](std::size_t i) -> const glm::dvec3& { return directions[i]; }, false, occluded);
 }
 
 template <class Direction>
@@ -290,8 +290,7 @@ void RayScene::OccludedAlong(const std::vector<RayStart>& starts, const Directio
     thread_local std::vector<RTCRay> rays;
     rays.clear();
     for (std::size_t i = 0; i < starts.size(); ++i) {
-        rays.push_back(
-            EmbreeRay(starts[i], direction(i), std::numeric_limits<double>::infinity()));
+        rays.push_back(EmbreeRay(starts[i], direction(i), std::numeric_limits<double>::infinity()));
     }
     StartContext context = MakeContext(0);
     if (coherent) context.context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;

@@ -86,8 +86,9 @@ void Timing(const std::string& csv, int photons) {
             RadiosityPhaseOptions options;
             options.level = level;
             const RadiosityPhase f = PhaseFromRadiosity(tree, options);
-            const char* name = level == 2 ? "bi 34² radiosity"
-                                          : level == 3 ? "bi 130² radiosity" : "bi 514² radiosity";
+            const char* name = level == 2   ? "bi 34² radiosity"
+                               : level == 3 ? "bi 130² radiosity"
+                                            : "bi 514² radiosity";
             row(name, DirectionSet::OfLevel(level).Size(), f.stats.rays + f.escapeRays, f.seconds,
                 f.phase.Bytes() / 1000.0);
         }
@@ -148,16 +149,16 @@ void PaperTable(const std::string& csv, int photons) {
         return PhaseFromRadiosity(branch, options);
     };
     const RadiosityPhase exact = radiosity(4);
-    std::printf("\nThe paper's §4.2.2 table on a generated branch (%s: %lld leaves, %zu "
-                "triangles), NIR band,\nagainst bi-directional 514² by radiosity (ε = 2e-3 of "
-                "a beam, %lld links, %.1f s)\n",
-                branch.Name().c_str(), static_cast<long long>(branch.LeafCount()),
-                branch.Flat().triangles.size(), static_cast<long long>(exact.stats.links),
-                exact.seconds);
+    std::printf(
+        "\nThe paper's §4.2.2 table on a generated branch (%s: %lld leaves, %zu "
+        "triangles), NIR band,\nagainst bi-directional 514² by radiosity (ε = 2e-3 of "
+        "a beam, %lld links, %.1f s)\n",
+        branch.Name().c_str(), static_cast<long long>(branch.LeafCount()),
+        branch.Flat().triangles.size(), static_cast<long long>(exact.stats.links), exact.seconds);
     std::FILE* out = std::fopen(csv.c_str(), "w");
     std::fprintf(out, "function,method,linf_pct,l2_pct,kB,seconds\n");
-    std::printf("%-10s %-9s %8s %8s %11s %9s\n", "function", "method", "L∞ %", "L2 %",
-                "size kB", "seconds");
+    std::printf("%-10s %-9s %8s %8s %11s %9s\n", "function", "method", "L∞ %", "L2 %", "size kB",
+                "seconds");
     const auto row = [&](const char* name, const char* method, const PhaseFunction& f,
                          double seconds) {
         const Difference d = Compare(f, exact.phase, band);
