@@ -4,11 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace leaflux {
 
 double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource>& sources,
-                     const ClosedLight& arrived, Field& field) {
+                     const ClosedLight& arrived, bool directional, Field& field) {
     const Hierarchy& hierarchy = model.Nodes();
     const DirectionSet& directions = model.Directions();
     const Channels& channels = model.ChannelSet();
@@ -27,7 +28,7 @@ double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource
         std::vector<glm::dvec3> towardSources(sources.size());
         for (std::size_t s = 0; s < sources.size(); ++s)
             towardSources[s] = closed.ToInstance(sources[s].toward);
-        std::vector<double> power(count, 0.0);
+        std::vector<double> power(count, 0.0), sent(static_cast<std::size_t>(bins) * count);
         for (int o = 0; o < bins; ++o) {
             for (int k = 0; k < count; ++k) {
                 const int band = channels.BandOf(k);
@@ -40,11 +41,20 @@ double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource
                     const double e = fromSources[s] * sources[s].normalIrradiance[k];
                     if (e != 0.0) intensity += e * contents.Phase(band, towardSources[s], local[o]);
                 }
-                change[c] = std::max(change[c], std::abs(intensity - out[o * count + k]));
-                largest[c] = std::max(largest[c], intensity);
-                out[o * count + k] = intensity;
+                sent[o * count + k] = intensity;
                 power[k] += intensity * directions.HatIntegralSr(o);
             }
+        }
+        if (!directional) {
+            for (int o = 0; o < bins; ++o) {
+                for (int k = 0; k < count; ++k)
+                    sent[o * count + k] = power[k] / (4.0 * std::numbers::pi);
+            }
+        }
+        for (std::size_t i = 0; i < sent.size(); ++i) {
+            change[c] = std::max(change[c], std::abs(sent[i] - out[i]));
+            largest[c] = std::max(largest[c], sent[i]);
+            out[i] = sent[i];
         }
         field.emitted[n] = channels.Measure(power.data());
     });

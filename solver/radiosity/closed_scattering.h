@@ -13,8 +13,9 @@
 namespace leaflux {
 
 // Writes every closed instance's intensity and emitted power into the field; returns the
-// largest change of an intensity over the largest intensity.
+// largest change of an intensity over the largest intensity. Not `directional`: each sends
+// its power alike in every direction (the single value of Soler 2003).
 double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource>& sources,
-                     const ClosedLight& arrived, Field& field);
+                     const ClosedLight& arrived, bool directional, Field& field);
 
 }  // namespace leaflux

@@ -102,10 +102,12 @@ class SceneSolve {
         : SceneSolve(scene, flat, rays, options, closed,
                      {static_cast<int>(scene.bands.size()), 1, ChannelMeasure::kSum},
                      BeamsOf(scene, options.skyCones)) {}
-    // Given channels and sources (UnitBeams).
+    // Given channels and sources (UnitBeams), and for a level of instantiation its occlusion
+    // and threshold (LevelProblem).
     SceneSolve(const Scene& scene, const FlatScene& flat, const RayScene& rays,
                const HrcOptions& options, std::span<const ClosedNode> closed,
-               const Channels& channels, std::vector<DirectionalSource> sources)
+               const Channels& channels, std::vector<DirectionalSource> sources,
+               const LevelProblem& level = {})
         : scene_(scene),
           flat_(flat),
           rays_(rays),
@@ -121,7 +123,10 @@ class SceneSolve {
           optics_(scene, flat, channels_),
           sources_(std::move(sources)),
           closedLight_(channels_, model_.BinCount(), closed.size(), sources_.size()),
-          occlusion_(rays, ProxiesOf(closed)),
+          ownOcclusion_(level.occlusion ? nullptr
+                                        : std::make_unique<Occlusion>(rays, ProxiesOf(closed))),
+          occlusion_(level.occlusion ? *level.occlusion : *ownOcclusion_),
+          level_(level),
           estimator_(model_, field_),
           visibility_(model_, field_, occlusion_, options.visibilityRays, options.sourceRays),
           pushPull_(model_, traversal_, exposure_) {
@@ -152,6 +157,8 @@ class SceneSolve {
     Solution RunLocal(NodeId root);
     // After Run under unit beams: the leaf patches and their radiosity.
     void Patches(BeamSolution& beams) const;
+    // After Run: what arrived on each closed instance, and the threshold the links took.
+    void Arrived(LevelSolution& level) const;
 
   private:
     void Solve(Solution& solution);
@@ -185,7 +192,8 @@ class SceneSolve {
         double residual =
             UpdateRadiosity(hierarchy_, traversal_.Leaves(), optics_, leafLight_, field_);
         if (Closed())
-            residual = std::max(residual, ScatterClosed(model_, sources_, closedLight_, field_));
+            residual = std::max(residual, ScatterClosed(model_, sources_, closedLight_,
+                                                        options_.directionalInstances, field_));
         return residual;
     }
     static std::vector<ClosedProxy> ProxiesOf(std::span<const ClosedNode> closed) {
@@ -229,7 +237,9 @@ class SceneSolve {
     const ReceiverOptics optics_;
     const std::vector<DirectionalSource> sources_;
     ClosedLight closedLight_;
-    const Occlusion occlusion_;
+    const std::unique_ptr<const Occlusion> ownOcclusion_;
+    const Occlusion& occlusion_;
+    const LevelProblem level_;  // its sources moved into sources_
     Links links_;
     Traversal traversal_;
     Exposure exposure_;
@@ -318,6 +328,10 @@ void SceneSolve::Solve(Solution& solution) {
 
     thresholds_ = {options_.epsilon * totalPower, options_.clusterTolerance,
                    perBeam ? std::size_t{1} : sources_.size()};
+    if (level_.errorW > 0.0) {  // a level under the top one: the top's threshold
+        thresholds_.errorW = level_.errorW;
+        thresholds_.sourceCount = std::max<std::size_t>(1, level_.sourceCount);
+    }
     refiner_.emplace(model_, field_, links_, estimator_, visibility_, sources_, thresholds_,
                      [this](std::uint32_t n) { OnSplit(n); });
     Refiner& refiner = *refiner_;
@@ -491,6 +505,22 @@ void SceneSolve::Outputs(Solution& solution) {
                               solution.balance);
 }
 
+void SceneSolve::Arrived(LevelSolution& level) const {
+    level.sources = sources_;
+    level.errorW = thresholds_.errorW;
+    level.sourceCount = thresholds_.sourceCount;
+    level.bins = model_.BinCount();
+    const std::size_t closed = hierarchy_.Closed().size();
+    const std::size_t width = static_cast<std::size_t>(model_.BinCount()) * channels_.Count();
+    level.arrivedBins.assign(closed, std::vector<double>(width, 0.0));
+    level.sourceVisibility.assign(closed, std::vector<double>(sources_.size(), 0.0));
+    if (thresholds_.errorW <= 0.0) return;  // nothing lit it
+    for (std::size_t c = 0; c < closed; ++c) {
+        std::copy_n(closedLight_.bins[c], width, level.arrivedBins[c].begin());
+        std::copy_n(closedLight_.sources[c], sources_.size(), level.sourceVisibility[c].begin());
+    }
+}
+
 void SceneSolve::Patches(BeamSolution& beams) const {
     beams.channels = channels_;
     beams.absorbedW.assign(channels_.Count(), 0.0);
@@ -538,6 +568,24 @@ Solution SolveHrc(const Scene& scene, const FlatScene& flat, const RayScene& ray
     SceneSolve solver(scene, flat, rays, options, closed);
     spdlog::debug("hrc: hierarchy built in {:.3f} s", watch.Lap());
     return solver.Run(clock);
+}
+
+LevelSolution SolveLevel(const Scene& scene, const FlatScene& flat, const RayScene& rays,
+                         const HrcOptions& options, std::span<const ClosedNode> closed,
+                         LevelProblem problem) {
+    LEAFLUX_CHECK(options.directionLevel >= 0 && options.directionLevel <= 4);
+    LEAFLUX_CHECK(!scene.bands.empty());
+    const ResourceClock clock;
+    std::vector<DirectionalSource> sources = std::move(problem.sources);
+    if (sources.empty()) sources = BeamsOf(scene, options.skyCones);
+    problem.sources.clear();
+    SceneSolve solver(scene, flat, rays, options, closed,
+                      {static_cast<int>(scene.bands.size()), 1, ChannelMeasure::kSum},
+                      std::move(sources), problem);
+    LevelSolution level;
+    level.solution = solver.Run(clock);
+    solver.Arrived(level);
+    return level;
 }
 
 LocalSolve SolveHrcThenLocal(const Scene& scene, const FlatScene& flat, const RayScene& rays,

@@ -45,6 +45,7 @@
 
 #include "solver/radiosity/channels.h"
 #include "solver/radiosity/closed_node.h"
+#include "solver/radiosity/links.h"
 #include "solver/raytrace/raytrace.h"
 #include "solver/results/light.h"
 
@@ -93,6 +94,10 @@ struct HrcOptions {
     int threads = 0;  // 0: every core
     // A continuous sky is discretised into these cones for the hierarchy's links.
     SkyDiscretization skyCones = SkyDiscretization::kTurtle46;
+    // A closed instance sends what its phase function makes of its light towards each
+    // direction of the cluster light's set; false: the same power alike in every direction,
+    // the single value of Soler 2003 (§6 names it the main error at small ε).
+    bool directionalInstances = true;
 };
 
 // `closed`: closed instances beside the scene's geometry (closed_node.h), each under the
@@ -131,6 +136,35 @@ struct BeamSolution {
 };
 BeamSolution SolveBeams(const Scene& scene, const FlatScene& flat, const RayScene& rays,
                         const HrcOptions& options, std::span<const glm::dvec3> towardSource);
+
+// One level of hierarchical instantiation (Soler 2003 §3.3–3.4; solver/instancing/instanced.h):
+// a part of a scene — the top with its largest instances closed, or an opened instance's
+// contents with its smaller instances closed — solved as a scene of its own: lit by the
+// given sources, its rays meeting what lies outside it through the occlusion's outside view,
+// its links refined under the threshold the top level chose.
+struct LevelProblem {
+    const Occlusion* occlusion = nullptr;  // rays' scene with `closed`'s proxies; null: its own
+    // The suns and sky cones, and the light that arrived from the rest of the scene
+    // (DirectionalSource::beyond false); empty: the scene's suns and sky cones.
+    std::vector<DirectionalSource> sources;
+    // The error a link may carry (W) and how many sources share it on a cluster of organs
+    // (Thresholds); errorW 0: ε times the power the sources bring onto its organs.
+    double errorW = 0.0;
+    std::size_t sourceCount = 0;
+};
+struct LevelSolution {
+    Solution solution;  // its receivers' light (those of the flat scene given)
+    std::vector<DirectionalSource> sources;
+    double errorW = 0.0;
+    std::size_t sourceCount = 0;
+    int bins = 0;  // of the cluster light's direction set (HrcOptions::directionLevel)
+    // Per closed instance, what arrived on it: from the level's nodes per bin, [bin][channel]
+    // in W/m² normal to the bin; and the visibility of each of the level's sources.
+    std::vector<std::vector<double>> arrivedBins, sourceVisibility;
+};
+LevelSolution SolveLevel(const Scene& scene, const FlatScene& flat, const RayScene& rays,
+                         const HrcOptions& options, std::span<const ClosedNode> closed,
+                         LevelProblem problem);
 
 struct LocalSolve {
     Solution whole, local;

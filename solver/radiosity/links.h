@@ -19,7 +19,7 @@ namespace leaflux {
 // Where a direction falls among the direction set's bins: three bins and their weights,
 // the first two in 65535ths and the third what they leave, so that the weights sum to 1
 // exactly in ten bytes.
-struct Bins {
+struct BinWeights {
     static constexpr double kUnit = 65535.0;
     std::array<std::uint16_t, 3> index{};
     std::array<std::uint16_t, 2> weight{};
@@ -29,12 +29,12 @@ struct Bins {
     }
 };
 
-inline Bins Locate(const DirectionSet& set, const glm::dvec3& direction) {
+inline BinWeights Locate(const DirectionSet& set, const glm::dvec3& direction) {
     const auto located = set.Locate(direction);
-    Bins bins;
+    BinWeights bins;
     for (int j = 0; j < 3; ++j) bins.index[j] = static_cast<std::uint16_t>(located.vertex[j]);
-    const auto first = static_cast<long>(std::lround(located.weight[0] * Bins::kUnit));
-    const auto second = static_cast<long>(std::lround(located.weight[1] * Bins::kUnit));
+    const auto first = static_cast<long>(std::lround(located.weight[0] * BinWeights::kUnit));
+    const auto second = static_cast<long>(std::lround(located.weight[1] * BinWeights::kUnit));
     bins.weight[0] = static_cast<std::uint16_t>(std::clamp(first, 0L, 65535L));
     bins.weight[1] = static_cast<std::uint16_t>(std::clamp(second, 0L, 65535L - bins.weight[0]));
     return bins;
@@ -61,7 +61,7 @@ struct NodeLink {
     // for a plane sender v Ω / π (PlaneSolidAngle), times its radiosity (bounded however
     // near).
     std::array<float, 3> transfer{};
-    Bins receiverBins, senderBins;  // not exact: R's bin of the light, S's bin that sends it
+    BinWeights receiverBins, senderBins;  // not exact: R's bin of the light, S's bin that sends it
     // For judging the link again with new light (Refiner::Rerefine) without its geometry:
     // the W it may carry per unit of its sender's light (the radiosity of S's side facing R,
     // or S's intensity towards R, Channels::Measure), or −1 when all S sends may reach R; W
@@ -114,6 +114,10 @@ struct DirectionalSource {
     glm::dvec3 toward;                     // unit, towards the source: the cone's axis
     std::vector<double> normalIrradiance;  // W/m² on a plane facing `toward`, per channel
     double cosRadius = 1.0;                // of the cone's half-angle
+    // Its rays meet what lies outside a local problem (OutsideView) as well: true for the
+    // scene's suns and sky cones; false for the light that arrived on an opened instance
+    // from the rest of the scene, whose shadows outside it that light already holds.
+    bool beyond = true;
 };
 
 // The links of one hierarchy, by receiver node.

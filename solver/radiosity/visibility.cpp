@@ -34,7 +34,7 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std:
     Random random(StreamSeed(static_cast<std::uint64_t>(set), r, s));
     const int count = visibilityRays_;
     const bool fromCluster = !hierarchy_[s].patch;
-    const bool boxes = occlusion_.ProxyCount() > 0;
+    const bool boxes = !occlusion_.TrianglesOnly();
     double visible = 0.0, total = 0.0, visibleLight = 0.0, totalLight = 0.0;
     int traced = 0;
     double passed = 0.0;
@@ -117,7 +117,35 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
     }
     rays += static_cast<std::int64_t>(starts.size());
     double visible = 0.0, total = 0.0;
-    if (occlusion_.ProxyCount() == 0) {  // triangles alone: traced together
+    if (const ShadowView& shadows = occlusion_.Shadows(); light.beyond && shadows.rays) {
+        // From triangles, through the whole scene's (traced together); from a closed
+        // instance's points, through the levels' triangles and closed instances.
+        thread_local std::vector<RayStart> whole;
+        thread_local std::vector<glm::dvec3> wholeDirections;
+        thread_local std::vector<double> wholeWeights;
+        whole.clear(), wholeDirections.clear(), wholeWeights.clear();
+        for (std::size_t i = 0; i < starts.size(); ++i) {
+            total += weights[i];
+            if (closed[i] >= 0) {
+                const std::int32_t ends[2] = {closed[i], -1};
+                visible += weights[i] * occlusion_.Transmittance(starts[i], directions[i],
+                                                                 INFINITY, Exclusion(ends));
+                continue;
+            }
+            whole.push_back({starts[i].origin + shadows.offset,
+                             shadows.triangleOf[starts[i].triangle]});
+            wholeDirections.push_back(directions[i]);
+            wholeWeights.push_back(weights[i]);
+        }
+        shadows.rays->Occluded(whole, wholeDirections, occluded);
+        for (std::size_t i = 0; i < whole.size(); ++i) {
+            if (!occluded[i]) visible += wholeWeights[i];
+        }
+        return total > 0.0 ? visible / total : 0.0;
+    }
+    // Light that arrived on an opened instance meets its contents alone.
+    if (light.beyond ? occlusion_.TrianglesOnly()
+                     : occlusion_.ProxyCount() == 0) {  // triangles alone: traced together
         if (beam) {
             occlusion_.Triangles().Occluded(starts, light.toward, occluded);
         } else {
@@ -132,8 +160,11 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
     for (std::size_t i = 0; i < starts.size(); ++i) {
         const std::int32_t ends[2] = {closed[i], -1};
         total += weights[i];
-        visible += weights[i] *
-                   occlusion_.Transmittance(starts[i], directions[i], INFINITY, Exclusion(ends));
+        visible += weights[i] * (light.beyond ? occlusion_.Transmittance(starts[i], directions[i],
+                                                                         INFINITY, Exclusion(ends))
+                                              : occlusion_.LocalTransmittance(
+                                                    starts[i], directions[i], INFINITY,
+                                                    Exclusion(ends)));
     }
     return total > 0.0 ? visible / total : 0.0;
 }

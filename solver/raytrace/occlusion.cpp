@@ -115,6 +115,13 @@ Occlusion::Occlusion(const RayScene& triangles, std::vector<ClosedProxy> proxies
     rtcCommitScene(scene_);
 }
 
+Occlusion::Occlusion(const RayScene& triangles, std::vector<ClosedProxy> proxies,
+                     OutsideView outside, ShadowView shadows)
+    : Occlusion(triangles, std::move(proxies)) {
+    outside_ = std::move(outside);
+    shadows_ = std::move(shadows);
+}
+
 Occlusion::~Occlusion() {
     if (scene_) rtcReleaseScene(scene_);
 }

@@ -38,6 +38,29 @@ struct ClosedProxy {
     std::function<double(const glm::dvec3&)> transmittance;
 };
 
+class Occlusion;
+
+// What lies outside a local problem (an opened instance, Soler 2003 §3.4): the occlusion of
+// the level it was opened in, its own proxy left out, so that rays from the opened contents
+// still meet the rest of the scene — that level's triangles, its closed instances, and what
+// lies outside it in turn. Each level keeps its own flat scene's origin (far-from-origin
+// scenes keep their precision): a local point p is at p + offset in the outside's frame.
+struct OutsideView {
+    const Occlusion* occlusion = nullptr;
+    std::vector<std::uint32_t> exclude;  // its proxies open around the local problem
+    glm::dvec3 offset{0.0};              // a point of the local frame is at p + offset there
+};
+
+// The whole scene's triangles, which the rays of the suns and sky cones from a level's
+// triangles meet instead of the levels' closed instances: exact shadows where the
+// transmittance of a closed instance would give its mean (Soler 2003 §4.3). A level's
+// triangle t is the whole scene's triangleOf[t]; a local point p is at p + offset there.
+struct ShadowView {
+    const RayScene* rays = nullptr;
+    std::vector<std::uint32_t> triangleOf;
+    glm::dvec3 offset{0.0};
+};
+
 class Occlusion {
   public:
     // `quality`: Embree's build quality of the boxes' hierarchy (the answer does not depend
@@ -45,6 +68,10 @@ class Occlusion {
     Occlusion(const RayScene& triangles, std::vector<ClosedProxy> proxies,
               RTCBuildQuality quality = RTC_BUILD_QUALITY_HIGH,
               std::shared_ptr<RayDevice> device = RayDevice::Shared());
+    // A local problem's: its own triangles and closed instances, then what lies outside; and
+    // the whole scene's triangles for direct light, when `shadows` has them.
+    Occlusion(const RayScene& triangles, std::vector<ClosedProxy> proxies, OutsideView outside,
+              ShadowView shadows = {});
     ~Occlusion();
     Occlusion(const Occlusion&) = delete;
     Occlusion& operator=(const Occlusion&) = delete;
@@ -53,14 +80,29 @@ class Occlusion {
     // 0 behind a triangle, else the product of τ of the closed instances crossed, but those
     // listed in `exclude` (indices into the proxies: a link's own ends and the instances
     // open around them).
+    // With an outside view, the light must pass the outside as well.
     double Transmittance(const RayStart& start, const glm::dvec3& direction,
                          double maxDistance = std::numeric_limits<double>::infinity(),
                          std::span<const std::uint32_t> exclude = {}) const {
+        const double local = LocalTransmittance(start, direction, maxDistance, exclude);
+        if (local <= 0.0 || outside_.occlusion == nullptr) return local;
+        // Nothing of the local problem is in the outside's scene: no triangle to skip.
+        const RayStart there{start.origin + outside_.offset};
+        return local * outside_.occlusion->Transmittance(there, direction, maxDistance,
+                                                         outside_.exclude);
+    }
+    // The same through the local problem's own triangles and closed instances alone.
+    double LocalTransmittance(const RayStart& start, const glm::dvec3& direction,
+                              double maxDistance = std::numeric_limits<double>::infinity(),
+                              std::span<const std::uint32_t> exclude = {}) const {
         if (triangles_.Occluded(start, direction, maxDistance)) return 0.0;
         return boxes_.empty() ? 1.0 : ThroughBoxes(start, direction, maxDistance, exclude);
     }
 
     std::size_t ProxyCount() const { return proxies_.size(); }
+    const ShadowView& Shadows() const { return shadows_; }
+    // Triangles alone, nothing outside: a ray passes or not (traced in batches).
+    bool TrianglesOnly() const { return proxies_.empty() && outside_.occlusion == nullptr; }
     const RayScene& Triangles() const { return triangles_; }
 
   private:
@@ -79,6 +121,8 @@ class Occlusion {
 
     const RayScene& triangles_;
     std::vector<ClosedProxy> proxies_;
+    OutsideView outside_;
+    ShadowView shadows_;
     std::vector<Box> boxes_;
     std::shared_ptr<RayDevice> device_;
     RTCScene scene_ = nullptr;

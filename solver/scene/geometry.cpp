@@ -45,6 +45,31 @@ FlatScene Flatten(const Scene& scene) {
     });
 }
 
+FlatScene ReceiversOf(const Scene& scene) {
+    FlatScene flat;
+    const auto worldFromLocal = WorldFromLocal(scene);
+    for (const Node& node : scene.nodes) {
+        if (!node.organ) continue;
+        flat.receivers.push_back({scene.NodeName(node), ReceiverKind::kOrgan, node.id,
+                                  scene.OpticsIndex(node.organ->opticsId)});
+        flat.receivers.back().areaM2 = MeshArea(*node.organ->mesh, worldFromLocal.at(node.id));
+    }
+    for (const Surface& surface : scene.environment) {
+        flat.receivers.push_back({surface.name, ReceiverKind::kEnvironment, 0,
+                                  scene.OpticsIndex(surface.opticsId)});
+        flat.receivers.back().areaM2 = MeshArea(*surface.mesh, glm::dmat4(1.0));
+    }
+    for (std::size_t e = 0; e < scene.sources.emitters.size(); ++e) {
+        const Emitter& emitter = scene.sources.emitters[e];
+        flat.receivers.push_back(
+            {emitter.name, ReceiverKind::kEmitter, 0,
+             emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId),
+             static_cast<int>(e)});
+        flat.receivers.back().areaM2 = MeshArea(*emitter.mesh, glm::dmat4(1.0));
+    }
+    return flat;
+}
+
 FlatScene Flatten(const Scene& scene, const PlacedOrgans& placed) {
     FlatScene flat;
     std::vector<Triangle> triangles;

@@ -51,6 +51,11 @@ struct FlatScene {
 // Flattens a validated scene. Receivers come in scene order: organs, environment, emitters.
 FlatScene Flatten(const Scene& scene);
 
+// The receivers Flatten would make, in its order, with their areas, and no triangles: what
+// per-receiver results are indexed by when the scene is never flattened whole (the
+// instanced solver).
+FlatScene ReceiversOf(const Scene& scene);
+
 // A mesh's triangles placed by worldFromLocal, in world coordinates (receiver 0).
 std::vector<Triangle> PlaceMesh(const Mesh& mesh, const glm::dmat4& worldFromLocal);
 // Flatten, with each organ's triangles as PlaceMesh placed them by its world frame (kept

@@ -1,0 +1,86 @@
+#include "solver/instancing/instance_tree.h"
+
+#include <algorithm>
+#include <limits>
+#include <unordered_map>
+
+namespace leaflux {
+namespace {
+// The box's pad, as a structure alone has it (structure.cpp): a thousandth of its diagonal,
+// at least a micrometre.
+constexpr double kPadFraction = 1e-3;
+constexpr double kMinPadM = 1e-6;
+}  // namespace
+
+InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures) {
+    const std::size_t count = scene.nodes.size();
+    std::unordered_map<NodeId, std::size_t> indexOf;
+    indexOf.reserve(count);
+    for (std::size_t i = 0; i < count; ++i) indexOf[scene.nodes[i].id] = i;
+    std::vector<std::vector<std::size_t>> children(count);
+    std::vector<std::size_t> roots;
+    for (std::size_t i = 0; i < count; ++i) {
+        const NodeId parent = scene.nodes[i].parent;
+        (parent == kNoParent ? roots : children[indexOf.at(parent)]).push_back(i);
+    }
+    // Each node's part, depth first from the roots; an instance opens a part of its own.
+    parts_.push_back(Part{});
+    std::vector<std::uint32_t> owner(count, kTop);
+    std::vector<std::pair<std::size_t, std::uint32_t>> stack;
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, kTop});
+    while (!stack.empty()) {
+        auto [i, part] = stack.back();
+        stack.pop_back();
+        const Node& node = scene.nodes[i];
+        if (const StructureSignature* s = signatures.Find(node.id); s && !s->signature.empty()) {
+            Part instance;
+            instance.root = node.id;
+            instance.rootIndex = i;
+            instance.parent = part;
+            instance.depth = parts_[part].depth + 1;
+            instance.signature = s->signature;
+            depth_ = std::max(depth_, instance.depth);
+            part = static_cast<std::uint32_t>(parts_.size());
+            parts_.push_back(std::move(instance));
+        }
+        owner[i] = part;
+        for (auto c = children[i].rbegin(); c != children[i].rend(); ++c) stack.push_back({*c, part});
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+        Part& part = parts_[owner[i]];
+        part.nodes.push_back(i);
+        const Node& node = scene.nodes[i];
+        if (node.organ) part.triangles += static_cast<std::int64_t>(node.organ->mesh->triangles.size());
+        if (owner[i] != kTop && parts_[owner[i]].root == node.id)
+            parts_[part.parent].instances.push_back(owner[i]);
+    }
+    // Boxes and areas over each instance's whole subtree, in its own frame.
+    const auto worldFromLocal = WorldFromLocal(scene);
+    for (std::uint32_t p = 1; p < parts_.size(); ++p) {
+        Part& part = parts_[p];
+        const glm::dmat4 worldFromInstance = worldFromLocal.at(part.root);
+        glm::dvec3 lo(std::numeric_limits<double>::max()), hi = -lo;
+        std::vector<std::pair<std::size_t, glm::dmat4>> walk{{part.rootIndex, glm::dmat4(1.0)}};
+        while (!walk.empty()) {
+            const auto [i, instanceFromNode] = walk.back();
+            walk.pop_back();
+            const Node& node = scene.nodes[i];
+            if (node.organ) {
+                for (const glm::dvec3& v : node.organ->mesh->positions) {
+                    const glm::dvec3 q(instanceFromNode * glm::dvec4(v, 1.0));
+                    lo = glm::min(lo, q);
+                    hi = glm::max(hi, q);
+                }
+                part.leafAreaM2 += MeshArea(*node.organ->mesh, worldFromInstance * instanceFromNode);
+            }
+            for (std::size_t c : children[i])
+                walk.push_back({c, instanceFromNode * scene.nodes[c].parentFromLocal});
+        }
+        if (lo.x > hi.x) lo = hi = glm::dvec3(0.0);  // no organ (signatures need a leaf)
+        const double pad = std::max(kMinPadM, kPadFraction * glm::length(hi - lo));
+        part.boxMin = lo - pad;
+        part.boxMax = hi + pad;
+    }
+}
+
+}  // namespace leaflux

@@ -1,0 +1,52 @@
+// The parts of a scene that hierarchical instantiation solves one at a time (Soler 2003
+// §3.2–3.4, Fig. 5): the top — everything that lies in no instance, and the largest
+// instances closed — and, for each instance, its contents: the nodes under it that lie in
+// no smaller instance, and its largest smaller instances closed. Each node belongs to one
+// part; an instance is the root of its own part and a closed member of its parent's.
+//
+// Instances are the structures whose signature the policy gives (signature.h). Everything
+// is in scene order, so it depends on nothing but the scene and the signatures.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <string>
+#include <vector>
+
+#include "solver/instancing/signature.h"
+#include "solver/scene/scene.h"
+
+namespace leaflux {
+
+class InstanceTree {
+  public:
+    static constexpr std::uint32_t kTop = 0;
+
+    struct Part {
+        NodeId root = kNoParent;        // the instance (kNoParent: the top)
+        std::size_t rootIndex = 0;      // its index into Scene::nodes
+        std::uint32_t parent = kTop;    // the part it is closed in
+        int depth = 0;                  // 0: the top, 1: its largest instances, …
+        std::string signature;          // the instance's
+        std::vector<std::size_t> nodes; // indices into Scene::nodes, in scene order
+        std::vector<std::uint32_t> instances;  // the parts closed in it, in scene order
+        // The instance's box in its own frame (its root's local frame) and its organs' area
+        // (one side, as an original's), over its whole subtree.
+        glm::dvec3 boxMin{0.0}, boxMax{0.0};
+        double leafAreaM2 = 0.0;
+        std::int64_t triangles = 0;  // of its own nodes' organs
+    };
+
+    // `signatures` of a validated scene (ComputeSignatures).
+    InstanceTree(const Scene& scene, const SceneSignatures& signatures);
+
+    const std::vector<Part>& Parts() const { return parts_; }
+    const Part& operator[](std::uint32_t part) const { return parts_[part]; }
+    int Depth() const { return depth_; }  // of the deepest instance (0: none)
+
+  private:
+    std::vector<Part> parts_;
+    int depth_ = 0;
+};
+
+}  // namespace leaflux

@@ -1,0 +1,340 @@
+#include "solver/instancing/instanced.h"
+
+#include <spdlog/spdlog.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <glm/gtc/matrix_transform.hpp>
+#include <mutex>
+#include <numbers>
+#include <unordered_map>
+
+#include "solver/instancing/instance_tree.h"
+#include "solver/instancing/original.h"
+#include "solver/instancing/scene_originals.h"
+#include "solver/instancing/signature.h"
+#include "solver/raytrace/occlusion.h"
+#include "solver/scene/geometry.h"
+#include "solver/util/directions.h"
+#include "solver/util/check.h"
+#include "solver/util/error.h"
+#include "solver/util/memory.h"
+
+namespace leaflux {
+namespace {
+
+// A member of a signature group as its original makes it: the original's transmittance, and
+// its phase function scaled by the member's organ area over the representative's, for a
+// structure intercepts and scatters in proportion to its area.
+class MemberContents : public ClosedContents {
+  public:
+    MemberContents(std::shared_ptr<const Original> original, double areaM2)
+        : original_(std::move(original)),
+          scale_(original_->provenance.leafAreaM2 > 0.0
+                     ? areaM2 / original_->provenance.leafAreaM2
+                     : 1.0) {}
+    double Transmittance(const glm::dvec3& omega) const override {
+        return original_->transmittance.Value(omega, 0);
+    }
+    double Phase(int band, const glm::dvec3& towardSource,
+                 const glm::dvec3& outgoing) const override {
+        return scale_ * original_->phase.Value(band, towardSource, outgoing);
+    }
+
+  private:
+    std::shared_ptr<const Original> original_;
+    double scale_;
+};
+
+// One part of the scene as a scene of its own, in the world frame, with its instances
+// closed; it lives while the parts under it are solved (their rays meet it).
+struct Level {
+    Scene scene;
+    FlatScene flat;
+    std::unique_ptr<RayScene> rays;
+    std::vector<ClosedNode> closed;
+    std::vector<std::uint32_t> closedPart;  // by closed instance: its part
+    std::vector<glm::dmat4> worldFromClosed;
+    std::unique_ptr<Occlusion> occlusion;
+};
+
+glm::dvec3 Centre(const glm::dvec3& lo, const glm::dvec3& hi) { return 0.5 * (lo + hi); }
+
+class InstancedSolve {
+  public:
+    InstancedSolve(const Scene& scene, const FlatScene& receivers, const RayScene* shadows,
+                   const InstanceTree& tree, const SceneOriginals& originals,
+                   const InstancedOptions& options, InstancedSolution& out)
+        : scene_(scene),
+          receivers_(receivers),
+          shadows_(shadows),
+          tree_(tree),
+          originals_(originals),
+          options_(options),
+          out_(out),
+          directions_(DirectionSet::OfLevel(options.hrc.directionLevel)) {
+        for (std::uint32_t r = 0; r < receivers.receivers.size(); ++r) {
+            const Receiver& receiver = receivers.receivers[r];
+            if (receiver.kind == ReceiverKind::kOrgan) {
+                organReceiver_[receiver.node] = r;
+            } else if (firstOther_ == kNoReceiver) {
+                firstOther_ = r;
+            }
+        }
+        out_.solution.light.assign(receivers.receivers.size(),
+                                   std::vector<BandLight>(scene.bands.size()));
+        out_.solution.balance.assign(scene.bands.size(), EnergyBalance{});
+        out_.stats.depths.assign(tree.Depth() + 1, InstancedStats::Depth{});
+        for (const InstanceTree::Part& part : tree.Parts()) ++out_.stats.depths[part.depth].instances;
+        out_.stats.depths[0].opened = 1;
+    }
+
+    void Run() {
+        const std::unique_ptr<Level> top = Build(InstanceTree::kTop, glm::dmat4(1.0), nullptr, 0);
+        LevelSolution light = Solve(InstanceTree::kTop, *top, {});
+        errorW_ = light.errorW;
+        sourceCount_ = light.sourceCount;
+        OpenInstances(*top, light);
+    }
+
+  private:
+    static constexpr std::uint32_t kNoReceiver = 0xFFFFFFFFu;
+
+    std::unique_ptr<Level> Build(std::uint32_t p, const glm::dmat4& worldFromRoot,
+                                 const Level* outside, std::uint32_t indexOutside) const;
+    LevelSolution Solve(std::uint32_t p, const Level& level, std::vector<DirectionalSource> sources);
+    // The scene's receiver that a level's receiver is.
+    std::uint32_t Global(const FlatScene& flat, std::uint32_t r) const {
+        const Receiver& receiver = flat.receivers[r];
+        if (receiver.kind == ReceiverKind::kOrgan) return organReceiver_.at(receiver.node);
+        // Environment surfaces and emitters are the top's, after its organs, in order.
+        std::uint32_t organs = 0;
+        while (organs < flat.receivers.size() &&
+               flat.receivers[organs].kind == ReceiverKind::kOrgan)
+            ++organs;
+        return firstOther_ + (r - organs);
+    }
+    ShadowView ShadowsOf(const FlatScene& flat) const;
+    // The light that arrived on closed instance c of `level`, as the sources of its contents.
+    std::vector<DirectionalSource> ArrivedOn(const LevelSolution& light, std::size_t c) const;
+    void OpenInstances(const Level& level, const LevelSolution& light);
+    void Open(const Level& parent, std::size_t c, std::vector<DirectionalSource> sources);
+
+    const Scene& scene_;
+    const FlatScene& receivers_;
+    const RayScene* const shadows_;
+    const InstanceTree& tree_;
+    const SceneOriginals& originals_;
+    const InstancedOptions& options_;
+    InstancedSolution& out_;
+    const DirectionSet& directions_;
+    std::unordered_map<NodeId, std::uint32_t> organReceiver_;
+    std::uint32_t firstOther_ = kNoReceiver;  // the first environment surface or emitter
+    double errorW_ = 0.0;
+    std::size_t sourceCount_ = 0;
+    std::mutex statsMutex_;
+};
+
+std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& worldFromRoot,
+                                             const Level* outside,
+                                             std::uint32_t indexOutside) const {
+    const InstanceTree::Part& part = tree_[p];
+    auto level = std::make_unique<Level>();
+    Scene& local = level->scene;
+    local.bands = scene_.bands;
+    local.optics = scene_.optics;
+    if (p == InstanceTree::kTop) {
+        local.environment = scene_.environment;
+        local.sources = scene_.sources;
+    }
+    local.nodes.reserve(part.nodes.size());
+    for (std::size_t i : part.nodes) {
+        Node node = scene_.nodes[i];
+        if (node.id == part.root) {
+            node.parent = kNoParent;
+            node.parentFromLocal = worldFromRoot;
+        }
+        local.nodes.push_back(std::move(node));
+    }
+    level->flat = Flatten(local);
+    // Its closed instances where they are in the world.
+    const auto worldFromLocal = WorldFromLocal(local);
+    glm::dvec3 middle(0.0);
+    for (std::uint32_t q : part.instances) {
+        const InstanceTree::Part& instance = tree_[q];
+        const Node& root = scene_.nodes[instance.rootIndex];
+        const glm::dmat4 world = root.parent == kNoParent
+                                     ? root.parentFromLocal
+                                     : worldFromLocal.at(root.parent) * root.parentFromLocal;
+        level->worldFromClosed.push_back(world);
+        middle += glm::dvec3(world * glm::dvec4(Centre(instance.boxMin, instance.boxMax), 1.0));
+    }
+    // A part of closed instances alone has no triangles to centre its frame on.
+    if (level->flat.Empty() && !part.instances.empty())
+        level->flat.origin = middle / static_cast<double>(part.instances.size());
+    const glm::dmat4 sceneFromWorld = glm::translate(glm::dmat4(1.0), -level->flat.origin);
+    for (std::size_t j = 0; j < part.instances.size(); ++j) {
+        const std::uint32_t q = part.instances[j];
+        const InstanceTree::Part& instance = tree_[q];
+        const Node& root = scene_.nodes[instance.rootIndex];
+        ClosedNode closed;
+        closed.name = scene_.NodeName(root);
+        closed.parent = root.parent;
+        closed.sceneFromInstance = sceneFromWorld * level->worldFromClosed[j];
+        closed.boxMin = instance.boxMin;
+        closed.boxMax = instance.boxMax;
+        closed.areaM2 = instance.leafAreaM2;
+        closed.contents = std::make_shared<MemberContents>(
+            originals_.bySignature.at(instance.signature), instance.leafAreaM2);
+        level->closed.push_back(std::move(closed));
+        level->closedPart.push_back(q);
+    }
+    level->rays = std::make_unique<RayScene>(level->flat, std::nullopt);
+    std::vector<ClosedProxy> proxies;
+    for (const ClosedNode& closed : level->closed) proxies.push_back(closed.Proxy());
+    OutsideView view;
+    if (outside != nullptr) {
+        view = {outside->occlusion.get(), {indexOutside}, level->flat.origin - outside->flat.origin};
+    }
+    level->occlusion = std::make_unique<Occlusion>(*level->rays, std::move(proxies),
+                                                   std::move(view), ShadowsOf(level->flat));
+    return level;
+}
+
+ShadowView InstancedSolve::ShadowsOf(const FlatScene& flat) const {
+    if (shadows_ == nullptr) return {};
+    ShadowView view{shadows_, std::vector<std::uint32_t>(flat.triangles.size()),
+                    flat.origin - receivers_.origin};
+    for (std::uint32_t r = 0; r < flat.receivers.size(); ++r) {
+        const Receiver& local = flat.receivers[r];
+        const Receiver& whole = receivers_.receivers[Global(flat, r)];
+        LEAFLUX_CHECK_EQ(local.triangleCount, whole.triangleCount);
+        for (std::uint32_t t = 0; t < local.triangleCount; ++t)
+            view.triangleOf[local.firstTriangle + t] = whole.firstTriangle + t;
+    }
+    return view;
+}
+
+LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
+                                    std::vector<DirectionalSource> sources) {
+    const auto start = std::chrono::steady_clock::now();
+    LevelProblem problem;
+    problem.occlusion = level.occlusion.get();
+    problem.sources = std::move(sources);
+    problem.errorW = errorW_;
+    problem.sourceCount = sourceCount_;
+    LevelSolution light = SolveLevel(level.scene, level.flat, *level.rays, options_.hrc,
+                                     level.closed, std::move(problem));
+    // Its receivers' light, where the scene has them.
+    const FlatScene& flat = level.flat;
+    for (std::uint32_t r = 0; r < flat.receivers.size(); ++r)
+        out_.solution.light[Global(flat, r)] = std::move(light.solution.light[r]);
+    InstancedStats::Problem size;
+    size.depth = tree_[p].depth;
+    size.triangles = static_cast<std::int64_t>(flat.triangles.size());
+    size.closed = static_cast<std::int64_t>(level.closed.size());
+    size.elements = light.solution.stats.elements;
+    size.links = light.solution.stats.links;
+    size.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::lock_guard lock(statsMutex_);
+    out_.stats.problems.push_back(size);
+    if (p != InstanceTree::kTop) ++out_.stats.depths[size.depth].opened;
+    Solution& solution = out_.solution;
+    solution.stats.rays += light.solution.stats.rays;
+    solution.stats.links = std::max(solution.stats.links, light.solution.stats.links);
+    solution.stats.elements = std::max(solution.stats.elements, light.solution.stats.elements);
+    solution.stats.iterations = std::max(solution.stats.iterations, light.solution.stats.iterations);
+    solution.stats.residual = std::max(solution.stats.residual, light.solution.stats.residual);
+    for (std::size_t b = 0; b < solution.balance.size(); ++b) {
+        solution.balance[b].absorbedW += light.solution.balance[b].absorbedW;
+        solution.balance[b].incidentW += light.solution.balance[b].incidentW;
+        if (p == InstanceTree::kTop) solution.balance[b].escapedW += light.solution.balance[b].escapedW;
+    }
+    return light;
+}
+
+std::vector<DirectionalSource> InstancedSolve::ArrivedOn(const LevelSolution& light,
+                                                         std::size_t c) const {
+    const int channels = static_cast<int>(scene_.bands.size());
+    std::vector<DirectionalSource> sources;
+    // The scene's suns and sky cones, traced again from the contents through everything.
+    for (const DirectionalSource& source : light.sources) {
+        if (source.beyond) sources.push_back(source);
+    }
+    // The rest, per bin: what the level's links brought, and what the cones of light that
+    // lit the level from further out brought through it.
+    std::vector<double> bins = light.arrivedBins[c];
+    for (std::size_t s = 0; s < light.sources.size(); ++s) {
+        const DirectionalSource& source = light.sources[s];
+        const double visibility = light.sourceVisibility[c][s];
+        if (source.beyond || visibility <= 0.0) continue;
+        const auto located = directions_.Locate(source.toward);
+        for (int j = 0; j < 3; ++j) {
+            for (int k = 0; k < channels; ++k)
+                bins[located.vertex[j] * channels + k] +=
+                    located.weight[j] * visibility * source.normalIrradiance[k];
+        }
+    }
+    for (int d = 0; d < light.bins; ++d) {
+        DirectionalSource cone{directions_.Direction(d),
+                               std::vector<double>(bins.begin() + d * channels,
+                                                   bins.begin() + (d + 1) * channels),
+                               1.0 - directions_.HatIntegralSr(d) / (2.0 * std::numbers::pi)};
+        cone.beyond = false;
+        double total = 0.0;
+        for (double e : cone.normalIrradiance) total += e;
+        if (total > 0.0) sources.push_back(std::move(cone));
+    }
+    return sources;
+}
+
+void InstancedSolve::OpenInstances(const Level& level, const LevelSolution& light) {
+    std::vector<std::vector<DirectionalSource>> arrived(level.closed.size());
+    for (std::size_t c = 0; c < level.closed.size(); ++c) arrived[c] = ArrivedOn(light, c);
+    // Siblings are independent once their parent is solved: each its own problem.
+    tbb::parallel_for(std::size_t{0}, level.closed.size(), [&](std::size_t c) {
+        Open(level, c, std::move(arrived[c]));
+    });
+}
+
+void InstancedSolve::Open(const Level& parent, std::size_t c,
+                          std::vector<DirectionalSource> sources) {
+    const std::uint32_t q = parent.closedPart[c];
+    const std::unique_ptr<Level> level =
+        Build(q, parent.worldFromClosed[c], &parent, static_cast<std::uint32_t>(c));
+    const LevelSolution light = Solve(q, *level, std::move(sources));
+    OpenInstances(*level, light);
+}
+
+}  // namespace
+
+InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& receivers,
+                                 const RayScene* shadows, const InstancingPolicy& policy,
+                                 PhaseDatabase& database, const InstancedOptions& options) {
+    if (scene.periodic)
+        throw InputError(ErrorCode::kUnsupported, "periodic",
+                         "the instanced solver does not repeat a tile; use hrc or mc");
+    const ResourceClock clock;
+    InstancedSolution out;
+    const SceneSignatures signatures = ComputeSignatures(scene, policy);
+    const SceneOriginals originals =
+        OriginalsOf(scene, signatures, policy, options.originals, database);
+    const InstanceTree tree(scene, signatures);
+    InstancedSolve solve(scene, receivers, shadows, tree, originals, options, out);
+    const auto start = std::chrono::steady_clock::now();
+    solve.Run();
+    out.stats.solveSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    out.stats.originalsComputed = originals.computed;
+    out.stats.originalsReused = originals.reused;
+    out.stats.originalSeconds = originals.computeSeconds;
+    const std::int64_t rays = out.solution.stats.rays;
+    clock.Stamp(out.solution.stats);
+    out.solution.stats.rays = rays;
+    out.stats.peakRssBytes = out.solution.stats.peakRssBytes;
+    spdlog::debug("instanced: {} parts, {} originals computed, {} reused", tree.Parts().size(),
+                  originals.computed, originals.reused);
+    return out;
+}
+
+}  // namespace leaflux

@@ -1,0 +1,81 @@
+// Hierarchical instantiation (`instanced`, Soler 2003 §3.2–3.5, Fig. 4–6): the scene's
+// structures that the policy gives a signature become instances of a shared original
+// (phase function and transmittance, from the phase-function database), and the scene is
+// solved one part at a time (instance_tree.h), so that the memory in use follows the depth
+// of instances rather than the size of the scene.
+//
+// 1. The top: everything that lies in no instance, with the largest instances closed
+//    (closed_node.h): links reach them but are not refined into them, they have no
+//    self-link, rays through them are attenuated by τ(ω), and each sends what its phase
+//    function makes of the light that arrived on it, per direction of the cluster light's
+//    set (HrcOptions::directionalInstances: false sends the paper's single value).
+// 2. Opening an instance (§3.4, Fig. 6): its contents are built as a local hierarchy, its
+//    smaller instances closed, and solved as a scene of its own (SolveLevel) under the
+//    light that arrived on it, held fixed: the suns and sky cones, their rays meeting the
+//    whole scene outside it (OutsideView: the levels it lies in, their closed instances
+//    but it), and the light of the rest of the scene, which the links that arrived on the
+//    instance brought per direction bin, as cones of light from the bins that meet its
+//    contents alone. Its links are refined under the top level's threshold, so that ε
+//    means the same at every depth. Its leaves' light is written as they are reached,
+//    its smaller instances opened in turn — siblings in parallel, each a problem of its
+//    own, so the answer does not depend on the number of threads — and then it is freed.
+//
+// Beyond the paper's link copies, which keep each arriving link with its sender and so
+// its parallax across the instance: the light from the rest of the scene is held as the
+// instance's incoming radiance per bin (34 directions at the default level), the same at
+// every point of it; the direct light, most of what leaves get, is traced from every
+// point through the whole scene.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "solver/instancing/compute_original.h"
+#include "solver/instancing/phase_db.h"
+#include "solver/instancing/policy.h"
+#include "solver/radiosity/hrc.h"
+#include "solver/results/light.h"
+
+namespace leaflux {
+
+struct InstancedOptions {
+    HrcOptions hrc;  // every level's radiosity, and ε
+    // How an original missing from the database is computed; the policy sets the kinds
+    // and direction sets of its functions (SettingsOf).
+    OriginalSettings originals;
+};
+
+struct InstancedStats {
+    struct Depth {
+        int instances = 0;  // structures instantiated at this depth (1: the largest)
+        int opened = 0;
+    };
+    std::vector<Depth> depths;  // [0] is the top
+    // Every part solved, the top first: the local problems' sizes (Fig. 14, right).
+    struct Problem {
+        int depth = 0;
+        std::int64_t triangles = 0, closed = 0, elements = 0, links = 0;
+        double seconds = 0.0;
+    };
+    std::vector<Problem> problems;
+    int originalsComputed = 0, originalsReused = 0;
+    double originalSeconds = 0.0;  // computing the missing originals
+    double solveSeconds = 0.0;     // everything else
+    std::int64_t peakRssBytes = 0;
+};
+
+struct InstancedSolution {
+    Solution solution;  // by the receivers of `receivers` (ReceiversOf the scene)
+    InstancedStats stats;
+};
+
+// `scene` validated and not periodic; `flat` its flat scene, or its receivers alone
+// (ReceiversOf) when `shadows` is null. `shadows`: the flat scene's rays, which the direct
+// light from the suns and sky cones then meets instead of the closed instances' τ (exact
+// shadows, for the memory of the whole scene's triangles). Throws InputError
+// (kUnsupported) for a periodic scene.
+InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& flat,
+                                 const RayScene* shadows, const InstancingPolicy& policy,
+                                 PhaseDatabase& database, const InstancedOptions& options);
+
+}  // namespace leaflux
