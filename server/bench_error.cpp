@@ -189,6 +189,29 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
         run.settings.hrc.epsilon = epsilon;
         runs.push_back(run);
     }
+    for (std::size_t i = 0; i < options.instancedEpsilons.size(); ++i) {
+        const double epsilon = options.instancedEpsilons[i];
+        Run run{"instanced", "epsilon=" + Number(epsilon) + hrcSetting, base};
+        run.settings.kind = SolverKind::kInstanced;
+        run.settings.hrc.epsilon = epsilon;
+        run.settings.instanced.policy = options.policy;
+        if (i == 0) {
+            Run cold = run;
+            cold.setting += " cold";
+            runs.push_back(cold);
+        }
+        runs.push_back(run);
+        if (i == options.instancedEpsilons.size() / 2) {
+            Run single = run;
+            single.setting += " single-value";
+            single.settings.hrc.directionalInstances = false;
+            runs.push_back(single);
+            Run tau = run;
+            tau.setting += " shadows=tau";
+            tau.settings.instanced.shadowsByGeometry = false;
+            runs.push_back(tau);
+        }
+    }
     if (options.directOnly) {
         // Deterministic direct light, as fine as the finest HRC run: what ignoring
         // scattering costs in accuracy, and what it saves in time.
@@ -329,8 +352,10 @@ int RunErrorBench(const ErrorBenchOptions& options) {
     std::vector<Row> rows =
         RowsOf({"mc", "reference samples=" + std::to_string(options.referenceSamples), {}}, scene,
                flat, *reference, *reference);
-    for (const Run& run : Runs(options)) {
+    PhaseDatabase originals(PhaseDatabaseOptions{});  // the instanced runs'
+    for (Run run : Runs(options)) {
         ResetPeakRss();
+        run.settings.instanced.database = &originals;
         const Solution solution = Solve(prepared, run.settings);
         spdlog::info("{} {}: {:.2f} s", run.solver, run.setting, solution.stats.wallSeconds);
         for (Row& row : RowsOf(run, scene, flat, *reference, solution)) rows.push_back(row);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "solver/instancing/policy.h"
 #include "solver/radiosity/hrc.h"
 
 namespace leaflux {
@@ -26,6 +27,11 @@ struct ErrorBenchOptions {
     std::vector<double> hrcEpsilons{1e-3, 1e-4, 1e-5};
     HrcOptions hrc;          // the HRC runs' other settings (subdivision, rays, directions)
     bool directOnly = true;  // also direct light only (HRC, the finest ε)
+    // Instanced runs under `policy`, its originals in one database in memory: the first ε
+    // from an empty database ("cold", computing them), then every ε from the full one; at
+    // the middle ε also the paper's single value and shadows by transmittance.
+    std::vector<double> instancedEpsilons;
+    InstancingPolicy policy;
     int threads = 0;
 };
 

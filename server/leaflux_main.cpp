@@ -15,12 +15,15 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <iostream>
 #include <sstream>
 
 #include "server/bench_error.h"
 #include "server/client.h"
+#include "server/instanced_cli.h"
 #include "server/phase_db_cli.h"
+#include "server/policy_proto.h"
 #include "server/policy_cli.h"
 #include "server/scene_proto.h"
 #include "solver/generate/generator.h"
@@ -42,6 +45,7 @@ struct SolveCommand {
     HrcOptions hrc;  // subdivision, rays and directions; ε and threads are set apart
     std::uint64_t seed = 1;
     bool directOnly = false, quiet = false, strict = false;
+    InstancedCommand instanced;
 };
 
 // HRC's settings besides ε, as options named `prefix` + name, their help after `label`.
@@ -74,7 +78,13 @@ void AddHrcSettings(CLI::App& app, HrcOptions& hrc, const std::string& prefix,
 int RunSolve(const SolveCommand& command) {
     const auto start = std::chrono::steady_clock::now();
     const Scene scene = LoadSceneFile(command.scene, ImportOptions{command.strict});
-    PreparedScene prepared(scene);
+    // The instanced solver with shadows by transmittance never flattens the scene whole.
+    const bool instanced = command.solver == "instanced";
+    const bool whole = !instanced || ShadowsByGeometry(command.instanced);
+    std::optional<PreparedScene> prepared;
+    if (whole) prepared.emplace(scene);
+    const FlatScene receivers = whole ? FlatScene{} : ReceiversOf(scene);
+    const FlatScene& flat = whole ? prepared->Flat() : receivers;
     SolverSettings settings;
     settings.monteCarlo.samplesPerReceiver = command.samples;
     settings.monteCarlo.replicates = command.replicates;
@@ -88,7 +98,7 @@ int RunSolve(const SolveCommand& command) {
     if (!command.quiet) {
         spdlog::info(
             "{}: {} receivers, {} triangles, {} bands; loaded in {:.2f} s", command.scene,
-            prepared.Flat().receivers.size(), prepared.Flat().triangles.size(), scene.bands.size(),
+            flat.receivers.size(), flat.triangles.size(), scene.bands.size(),
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         settings.monteCarlo.progress = [last = -1](double done) mutable {
             const int tenth = static_cast<int>(done * 10.0);
@@ -99,21 +109,24 @@ int RunSolve(const SolveCommand& command) {
             }
         };
     }
-    const Solution solution = Solve(prepared, settings);
+    const Solution solution =
+        instanced ? RunInstanced(scene, flat, whole ? &prepared->Rays() : nullptr, settings.hrc,
+                                 command.instanced)
+                  : Solve(*prepared, settings);
     std::ofstream leaves(command.out);
     if (!leaves) throw InputError(ErrorCode::kIo, command.out, "cannot write");
-    WriteLeafCsv(leaves, scene, prepared.Flat(), solution);
+    WriteLeafCsv(leaves, scene, flat, solution);
     if (!command.structures.empty()) {
         std::ofstream structures(command.structures);
         if (!structures) throw InputError(ErrorCode::kIo, command.structures, "cannot write");
-        WriteStructureCsv(structures, scene, AggregateStructures(scene, prepared.Flat(), solution));
+        WriteStructureCsv(structures, scene, AggregateStructures(scene, flat, solution));
     }
     if (!command.ply.empty()) {
         std::ofstream ply(command.ply);
         if (!ply) throw InputError(ErrorCode::kIo, command.ply, "cannot write");
-        WritePly(ply, prepared.Flat(), solution, 0);
+        WritePly(ply, flat, solution, 0);
     }
-    std::cout << Summary(command.solver, scene, prepared.Flat(), solution) << std::endl;
+    std::cout << Summary(command.solver, scene, flat, solution) << std::endl;
     for (const LinkAudit& audit : solution.linkAudit) {
         if (audit.links == 0) {  // the partition's check: rays where no link or two cover
             std::printf("points %-41s: rays find %.6g ± %.2g W\n", audit.kind.c_str(), audit.foundW,
@@ -303,16 +316,19 @@ int main(int argc, char** argv) {
     solveApp
         ->add_option(
             "--solver", solve.solver,
-            "Solver: mc (Monte Carlo reference) or hrc (hierarchical radiosity with clustering)")
-        ->check(CLI::IsMember({"mc", "hrc"}));
+            "Solver: mc (Monte Carlo reference), hrc (hierarchical radiosity with clustering) "
+            "or instanced (hierarchical instantiation: structures the policy names solved as "
+            "instances of shared phase functions, one at a time)")
+        ->check(CLI::IsMember({"mc", "hrc", "instanced"}));
     solveApp
         ->add_option(
             "--epsilon", solve.epsilon,
-            "hrc: largest error of a link, as a fraction of the power the suns and sky bring "
+            "hrc, instanced: largest error of a link, as a fraction of the power the suns and sky bring "
             "onto the organs (plus the lamps' power); surfaces far from the organs are "
             "allowed more by the square of their distance")
         ->check(CLI::Range(1e-9, 1.0));
-    AddHrcSettings(*solveApp, solve.hrc, "--", "hrc: ");
+    AddHrcSettings(*solveApp, solve.hrc, "--", "hrc, instanced: ");
+    AddInstancedOptions(*solveApp, solve.instanced);
     solveApp->add_flag("--audit-links", solve.hrc.auditLinks,
                        "hrc: after the solve, set each kind of link against 64 rays from each "
                        "side of every leaf patch (the power handed on, with the solution's "
@@ -485,6 +501,16 @@ int main(int argc, char** argv) {
         ->delimiter(',')
         ->check(CLI::Range(1e-9, 1.0));
     AddHrcSettings(*errorApp, errorBench.hrc, "--hrc-", "HRC runs: ");
+    std::string benchPolicy;
+    errorApp
+        ->add_option("--instanced-epsilon", errorBench.instancedEpsilons,
+                     "Instanced runs: ε of each (none by default); the first also from an empty "
+                     "phase-function database, the middle one also with the single value and "
+                     "with shadows by transmittance")
+        ->delimiter(',')
+        ->check(CLI::Range(1e-9, 1.0));
+    errorApp->add_option("--policy", benchPolicy,
+                         "Instanced runs: instantiation policy file (default: the built-in one)");
     errorApp->add_flag("!--no-direct", errorBench.directOnly,
                        "No direct-light-only run (HRC at the finest ε)");
     bool noMonteCarlo = false, noHrc = false;
@@ -512,6 +538,7 @@ int main(int argc, char** argv) {
             if (noHrc) errorBench.hrcEpsilons.clear();
             errorBench.csv = errorBenchOut + "/" + errorBench.name + ".csv";
             if (!noPlot) errorBench.png = errorBenchOut + "/" + errorBench.name + ".png";
+            errorBench.policy = benchPolicy.empty() ? DefaultPolicy() : LoadPolicyFile(benchPolicy);
             return RunErrorBench(errorBench);
         }
         if (keygenApp->parsed()) {

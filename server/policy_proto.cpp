@@ -2,8 +2,12 @@
 
 #include <array>
 
+#include <google/protobuf/text_format.h>
+
+#include "server/default_policy.h"
 #include "server/scene_proto.h"
 #include "server/text_format.h"
+#include "solver/util/check.h"
 #include "solver/util/directions.h"
 #include "solver/util/error.h"
 
@@ -116,6 +120,12 @@ InstancingPolicy LoadPolicyFile(const std::string& path) {
         Fail(error->unreadable ? ErrorCode::kIo : ErrorCode::kParse, error->where,
              error->unreadable ? "cannot open the policy file" : error->what);
     }
+    return PolicyFromProto(message);
+}
+
+InstancingPolicy DefaultPolicy() {
+    v1::InstancingPolicy message;
+    LEAFLUX_CHECK(google::protobuf::TextFormat::ParseFromString(kDefaultPolicyText, &message));
     return PolicyFromProto(message);
 }
 

@@ -20,4 +20,7 @@ InstancingPolicy PolicyFromProto(const v1::InstancingPolicy& message);
 // parses but is not usable is the InputError of PolicyFromProto, naming the field.
 InstancingPolicy LoadPolicyFile(const std::string& path);
 
+// proto/policies/default.txtpb, built in: for a species no policy has been fitted to.
+InstancingPolicy DefaultPolicy();
+
 }  // namespace leaflux

@@ -1,5 +1,7 @@
 #include "solver/solve.h"
 
+#include <optional>
+
 #include "solver/util/error.h"
 
 namespace leaflux {
@@ -33,6 +35,19 @@ Solution Solve(const PreparedScene& prepared, const SolverSettings& settings) {
                                  "the hrc solver does not handle periodic domains yet: use mc");
             }
             return SolveHrc(prepared.Source(), prepared.Flat(), prepared.Rays(), settings.hrc);
+        case SolverKind::kInstanced: {
+            const InstancedSettings& instanced = settings.instanced;
+            std::optional<PhaseDatabase> own;
+            PhaseDatabase* database = instanced.database;
+            if (database == nullptr) database = &own.emplace(PhaseDatabaseOptions{});
+            InstancedOptions options{settings.hrc, instanced.originals};
+            InstancedSolution solved = SolveInstanced(
+                prepared.Source(), prepared.Flat(),
+                instanced.shadowsByGeometry ? &prepared.Rays() : nullptr, instanced.policy,
+                *database, options);
+            if (instanced.stats != nullptr) *instanced.stats = std::move(solved.stats);
+            return std::move(solved.solution);
+        }
     }
     return {};
 }

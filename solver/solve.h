@@ -4,6 +4,7 @@
 #include <memory>
 #include <string>
 
+#include "solver/instancing/instanced.h"
 #include "solver/radiosity/hrc.h"
 #include "solver/raytrace/raytrace.h"
 #include "solver/reference/reference.h"
@@ -11,12 +12,24 @@
 
 namespace leaflux {
 
-enum class SolverKind { kMonteCarlo, kHrc };
+enum class SolverKind { kMonteCarlo, kHrc, kInstanced };
+
+// The instanced solver's: its policy, the database its originals come from and go to,
+// and what direct light meets (instanced.h). Its radiosity settings are `hrc`'s.
+struct InstancedSettings {
+    InstancingPolicy policy;           // required: a policy with an instance type
+    PhaseDatabase* database = nullptr;  // null: one in memory for this solve
+    OriginalSettings originals;
+    bool shadowsByGeometry = true;
+    // Filled by the solve when not null: its instances, local problems and originals.
+    InstancedStats* stats = nullptr;
+};
 
 struct SolverSettings {
     SolverKind kind = SolverKind::kMonteCarlo;
     ReferenceOptions monteCarlo;
     HrcOptions hrc;
+    InstancedSettings instanced;
 };
 
 // A scene prepared for solving: flattened and committed to the ray engine. Build it once

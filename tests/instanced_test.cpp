@@ -136,3 +136,19 @@ TEST(InstancedExplore, Tree) {
     std::printf("originals %d\n", instanced.stats.originalsComputed);
 }
 }  // namespace leaflux
+namespace leaflux {
+TEST(InstancedExplore, SingleVsDirectional) {
+    const Scene scene = Copies(4, 120, 1.2);
+    const PreparedScene prepared(scene);
+    PhaseDatabase database({});
+    InstancedOptions options;
+    options.hrc.epsilon = 1e-4;
+    const InstancedSolution a = SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+    options.hrc.directionalInstances = false;
+    const InstancedSolution b = SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+    double d = 0;
+    for (std::size_t r = 0; r < a.solution.light.size(); ++r) d = std::max(d, std::abs(a.solution.light[r][1].irradianceUpperWm2 - b.solution.light[r][1].irradianceUpperWm2));
+    std::printf("max diff %g\n", d);
+    for (auto& p : a.stats.problems) std::printf("problem depth %d tri %lld closed %lld elements %lld links %lld\n", p.depth, (long long)p.triangles, (long long)p.closed, (long long)p.elements, (long long)p.links);
+}
+}

@@ -3,7 +3,9 @@
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
+#include <tuple>
 #include <glm/gtc/matrix_transform.hpp>
 #include <mutex>
 #include <numbers>
@@ -325,6 +327,12 @@ InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& receivers,
     solve.Run();
     out.stats.solveSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    // The problems by depth and size, whatever order the threads solved them in.
+    std::sort(out.stats.problems.begin(), out.stats.problems.end(),
+              [](const InstancedStats::Problem& a, const InstancedStats::Problem& b) {
+                  return std::tie(a.depth, a.triangles, a.elements, a.links) <
+                         std::tie(b.depth, b.triangles, b.elements, b.links);
+              });
     out.stats.originalsComputed = originals.computed;
     out.stats.originalsReused = originals.reused;
     out.stats.originalSeconds = originals.computeSeconds;

@@ -8,8 +8,35 @@
 
 namespace leaflux {
 
+ClosedResponse::ClosedResponse(const NodeModel& model,
+                               const std::vector<DirectionalSource>& sources)
+    : bands_(model.ChannelSet().bands),
+      bins_(model.BinCount()),
+      inputs_(model.BinCount() + sources.size()) {
+    const Hierarchy& hierarchy = model.Nodes();
+    const DirectionSet& directions = model.Directions();
+    const std::size_t closedCount = hierarchy.Closed().size();
+    values_.assign(closedCount * bands_ * bins_ * inputs_, 0.0);
+    tbb::parallel_for(std::size_t{0}, closedCount, [&](std::size_t c) {
+        const ClosedNode& closed = hierarchy.Closed()[c];
+        std::vector<glm::dvec3> in(inputs_), out(bins_);
+        for (std::size_t d = 0; d < bins_; ++d)
+            out[d] = in[d] = closed.ToInstance(directions.Direction(static_cast<int>(d)));
+        for (std::size_t s = 0; s < sources.size(); ++s)
+            in[bins_ + s] = closed.ToInstance(sources[s].toward);
+        for (std::size_t b = 0; b < bands_; ++b) {
+            for (std::size_t o = 0; o < bins_; ++o) {
+                double* row = values_.data() + ((c * bands_ + b) * bins_ + o) * inputs_;
+                for (std::size_t i = 0; i < inputs_; ++i)
+                    row[i] = closed.contents->Phase(static_cast<int>(b), in[i], out[o]);
+            }
+        }
+    });
+}
+
 double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource>& sources,
-                     const ClosedLight& arrived, bool directional, Field& field) {
+                     const ClosedResponse& response, const ClosedLight& arrived, bool directional,
+                     Field& field) {
     const Hierarchy& hierarchy = model.Nodes();
     const DirectionSet& directions = model.Directions();
     const Channels& channels = model.ChannelSet();
@@ -17,30 +44,18 @@ double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource
     const std::size_t closedCount = hierarchy.Closed().size();
     std::vector<double> change(closedCount, 0.0), largest(closedCount, 0.0);
     tbb::parallel_for(std::size_t{0}, closedCount, [&](std::size_t c) {
-        const ClosedNode& closed = hierarchy.Closed()[c];
-        const ClosedContents& contents = *closed.contents;
         const std::uint32_t n = hierarchy.NodeOfClosed(static_cast<std::int32_t>(c));
         double* out = field.intensity[model.Slot(n)];
         const double* fromBins = arrived.bins[c];
         const double* fromSources = arrived.sources[c];
-        std::vector<glm::dvec3> local(bins);
-        for (int d = 0; d < bins; ++d) local[d] = closed.ToInstance(directions.Direction(d));
-        std::vector<glm::dvec3> towardSources(sources.size());
-        for (std::size_t s = 0; s < sources.size(); ++s)
-            towardSources[s] = closed.ToInstance(sources[s].toward);
         std::vector<double> power(count, 0.0), sent(static_cast<std::size_t>(bins) * count);
         for (int o = 0; o < bins; ++o) {
             for (int k = 0; k < count; ++k) {
-                const int band = channels.BandOf(k);
+                const double* f = response.Row(c, channels.BandOf(k), o);
                 double intensity = 0.0;
-                for (int i = 0; i < bins; ++i) {
-                    const double e = fromBins[i * count + k];
-                    if (e != 0.0) intensity += e * contents.Phase(band, local[i], local[o]);
-                }
-                for (std::size_t s = 0; s < sources.size(); ++s) {
-                    const double e = fromSources[s] * sources[s].normalIrradiance[k];
-                    if (e != 0.0) intensity += e * contents.Phase(band, towardSources[s], local[o]);
-                }
+                for (int i = 0; i < bins; ++i) intensity += fromBins[i * count + k] * f[i];
+                for (std::size_t s = 0; s < sources.size(); ++s)
+                    intensity += fromSources[s] * sources[s].normalIrradiance[k] * f[bins + s];
                 sent[o * count + k] = intensity;
                 power[k] += intensity * directions.HatIntegralSr(o);
             }

@@ -12,10 +12,27 @@
 
 namespace leaflux {
 
+// f(ωi, ωo) of every closed instance between the directions a solve knows — from each bin
+// of the cluster light's set and each directional source, towards each bin — in its own
+// frame, per band: looked up once, for those directions do not change within a solve.
+class ClosedResponse {
+  public:
+    ClosedResponse(const NodeModel& model, const std::vector<DirectionalSource>& sources);
+    // f of closed instance c in band b towards bin o, from input i: bins first, then sources.
+    const double* Row(std::size_t c, int band, int o) const {
+        return values_.data() + ((c * bands_ + band) * bins_ + o) * inputs_;
+    }
+
+  private:
+    std::size_t bands_, bins_, inputs_;
+    std::vector<double> values_;
+};
+
 // Writes every closed instance's intensity and emitted power into the field; returns the
 // largest change of an intensity over the largest intensity. Not `directional`: each sends
 // its power alike in every direction (the single value of Soler 2003).
 double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource>& sources,
-                     const ClosedLight& arrived, bool directional, Field& field);
+                     const ClosedResponse& response, const ClosedLight& arrived, bool directional,
+                     Field& field);
 
 }  // namespace leaflux

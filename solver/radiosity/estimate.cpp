@@ -85,8 +85,12 @@ Estimate Estimator::Pair(std::uint32_t r, std::uint32_t s, Points rule) const {
             // overshot: on the dense canopy these links handed on 1.032 of what rays from
             // their senders landed (the audit of then) (0.962 uncorrected), over the
             // children 1.016.
+            // A node without children (a closed instance) is its own part.
             e.geometric = 0.0;
-            for (std::uint32_t child : R.children) {
+            const std::span<const std::uint32_t> parts =
+                R.children.empty() ? std::span<const std::uint32_t>(&r, 1)
+                                   : std::span<const std::uint32_t>(R.children);
+            for (std::uint32_t child : parts) {
                 const HrcNode& C = hierarchy_[child];
                 const glm::dvec3 gap = S.centroid - C.centroid;
                 const double square = std::max(glm::dot(gap, gap), 1e-300);

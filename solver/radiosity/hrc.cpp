@@ -191,9 +191,12 @@ class SceneSolve {
     double Update() {
         double residual =
             UpdateRadiosity(hierarchy_, traversal_.Leaves(), optics_, leafLight_, field_);
-        if (Closed())
-            residual = std::max(residual, ScatterClosed(model_, sources_, closedLight_,
-                                                        options_.directionalInstances, field_));
+        if (Closed()) {
+            if (!closedResponse_) closedResponse_.emplace(model_, sources_);
+            residual = std::max(residual,
+                                ScatterClosed(model_, sources_, *closedResponse_, closedLight_,
+                                              options_.directionalInstances, field_));
+        }
         return residual;
     }
     static std::vector<ClosedProxy> ProxiesOf(std::span<const ClosedNode> closed) {
@@ -237,6 +240,7 @@ class SceneSolve {
     const ReceiverOptics optics_;
     const std::vector<DirectionalSource> sources_;
     ClosedLight closedLight_;
+    std::optional<ClosedResponse> closedResponse_;  // made on the first update
     const std::unique_ptr<const Occlusion> ownOcclusion_;
     const Occlusion& occlusion_;
     const LevelProblem level_;  // its sources moved into sources_

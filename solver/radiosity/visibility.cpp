@@ -65,7 +65,7 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std:
         }
         const std::int32_t ends[2] = {p.closed, q.closed};
         const double through =
-            occlusion_.Transmittance(start, d / distance, length, Exclusion(ends));
+            occlusion_.LocalTransmittance(start, d / distance, length, Exclusion(ends));
         visible += weight * through;
         visibleLight += light * through;
         passed += through;

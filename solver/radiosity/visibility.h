@@ -72,6 +72,9 @@ class LinkVisibility {
     // ground patches handed on 0.74 of what rays from their senders landed (the audit of then) and
     // its NIR balance was 0.83 % off; now 0.80 and 0.38 %. The radiosity is that of when the link
     // is valued: the direct light's at first, the solution's in the refine–solve passes.
+    // In a local problem the rays meet its own triangles and closed instances only
+    // (Occlusion::LocalTransmittance): the rest of the scene's shadow on its inner
+    // exchanges is left out (on the 10k tree, no worse for 40 % less time).
     // Counts the rays it traces in `rays`.
     Sight Between(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
                   double unoccluded = 0.0) const;

@@ -1,0 +1,75 @@
+#include "server/instanced_cli.h"
+
+#include <cstdio>
+#include <fstream>
+
+#include "server/policy_proto.h"
+#include "solver/instancing/phase_db.h"
+#include "solver/util/error.h"
+
+namespace leaflux {
+
+void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
+    command.phaseDb = DefaultPhaseDatabasePath();
+    solve.add_option("--policy", command.policy,
+                     "instanced: instantiation policy file (protobuf text format, "
+                     "leaflux.v1.InstancingPolicy); default: the built-in general policy, "
+                     "plants and axes by their leaf count in orders of magnitude");
+    solve.add_option("--phase-db", command.phaseDb,
+                     "instanced: phase-function database file, read and extended")
+        ->capture_default_str();
+    solve.add_flag("--no-phase-db", command.noPhaseDb,
+                   "instanced: keep the phase functions in memory only");
+    solve.add_option("--phase-db-mb", command.phaseDbMb,
+                     "instanced: the database's buffer in memory (MB)")
+        ->capture_default_str()
+        ->check(CLI::Range(1.0, 1e6));
+    solve
+        .add_option("--shadows", command.shadows,
+                    "instanced: what direct light from the suns and sky meets: geometry (every "
+                    "triangle of the scene, exact shadows, the scene's triangles in memory) or "
+                    "transmittance (the closed instances' τ, the paper's; memory follows the "
+                    "depth of instances)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"geometry", "transmittance"}));
+    solve.add_flag("--single-value", command.singleValue,
+                   "instanced: a closed instance sends its power alike in every direction (the "
+                   "paper's single value) instead of by direction");
+    solve.add_option("--problems", command.problems,
+                     "instanced: CSV of every local problem solved: depth, triangles, closed "
+                     "instances, elements, links, seconds");
+}
+
+Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene* shadows,
+                      const HrcOptions& hrc, const InstancedCommand& command) {
+    const InstancingPolicy policy =
+        command.policy.empty() ? DefaultPolicy() : LoadPolicyFile(command.policy);
+    PhaseDatabase database(
+        {command.noPhaseDb ? "" : command.phaseDb, command.phaseDbMb, 0.0, true});
+    if (!database.Health().empty())
+        std::fprintf(stderr, "phase-function database: %s; going on in memory\n",
+                     database.Health().c_str());
+    InstancedOptions options;
+    options.hrc = hrc;
+    options.hrc.directionalInstances = !command.singleValue;
+    const InstancedSolution solved =
+        SolveInstanced(scene, flat, shadows, policy, database, options);
+    const InstancedStats& stats = solved.stats;
+    std::printf("instances by depth (opened):");
+    for (std::size_t d = 1; d < stats.depths.size(); ++d)
+        std::printf(" %zu: %d (%d)", d, stats.depths[d].instances, stats.depths[d].opened);
+    std::printf("\nphase functions: %d computed in %.2f s, %d reused; solving %.2f s; peak %.1f MiB\n",
+                stats.originalsComputed, stats.originalSeconds, stats.originalsReused,
+                stats.solveSeconds, stats.peakRssBytes / 1048576.0);
+    if (!command.problems.empty()) {
+        std::ofstream out(command.problems);
+        if (!out) throw InputError(ErrorCode::kIo, command.problems, "cannot write");
+        out << "depth,triangles,closed,elements,links,seconds\n";
+        for (const InstancedStats::Problem& p : stats.problems)
+            out << p.depth << ',' << p.triangles << ',' << p.closed << ',' << p.elements << ','
+                << p.links << ',' << p.seconds << '\n';
+    }
+    return solved.solution;
+}
+
+}  // namespace leaflux

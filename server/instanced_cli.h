@@ -1,0 +1,36 @@
+// The instanced solver from the command line (`leaflux solve --solver instanced`): its
+// options, and its statistics printed after the summary.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "solver/instancing/instanced.h"
+
+namespace leaflux {
+
+struct InstancedCommand {
+    std::string policy;  // a policy file; empty: the built-in default policy
+    std::string phaseDb;
+    bool noPhaseDb = false;
+    double phaseDbMb = 256.0;
+    std::string shadows = "geometry";
+    bool singleValue = false;
+    std::string problems;  // CSV of the local problems solved
+};
+
+// Adds the instanced solver's options to `solve`.
+void AddInstancedOptions(CLI::App& solve, InstancedCommand& command);
+
+// Whether direct light meets the whole scene's triangles (then the scene is flattened
+// whole).
+inline bool ShadowsByGeometry(const InstancedCommand& command) {
+    return command.shadows == "geometry";
+}
+
+// Solves with the instanced solver and prints its statistics; `shadows` the flat scene's
+// rays when ShadowsByGeometry, else null and `flat` the receivers alone.
+Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene* shadows,
+                      const HrcOptions& hrc, const InstancedCommand& command);
+
+}  // namespace leaflux
