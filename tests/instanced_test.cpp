@@ -53,102 +53,100 @@ InstancingPolicy Plants() {
     return policy;
 }
 
-TEST(Instanced, ExactCopiesLightTheirLeavesAsTheFlattenedScene) {
-    const Scene scene = Copies(4, 120, std::getenv("SPACING") ? std::atof(std::getenv("SPACING")) : 1.2);
+Solution Hrc(const PreparedScene& prepared, double epsilon) {
+    SolverSettings settings;
+    settings.kind = SolverKind::kHrc;
+    settings.hrc.epsilon = epsilon;
+    return Solve(prepared, settings);
+}
+
+// A policy that finds no structure: one level, the whole scene, as HRC solves it.
+TEST(Instanced, WithoutInstancesItIsHrc) {
+    const Scene scene = Copies(2, 60);
     const PreparedScene prepared(scene);
-    SolverSettings flat;
-    flat.kind = SolverKind::kHrc;
-    flat.hrc.epsilon = 1e-4;
-    const Solution hrc = Solve(prepared, flat);
+    const Solution hrc = Hrc(prepared, 1e-4);
+    InstancingPolicy none = Plants();
+    none.instanceTypes = {NodeType::kFruit};
     PhaseDatabase database({});
     InstancedOptions options;
-    options.hrc = flat.hrc;
+    options.hrc.epsilon = 1e-4;
     const InstancedSolution instanced =
-        SolveInstanced(scene, prepared.Flat(), std::getenv("TAU") ? nullptr : &prepared.Rays(), Plants(), database, options);
-    EXPECT_EQ(instanced.stats.originalsComputed, 1);
-    ASSERT_EQ(instanced.stats.depths.size(), 2u);
-    EXPECT_EQ(instanced.stats.depths[1].instances, 4);
-    EXPECT_EQ(instanced.stats.depths[1].opened, 4);
-    SolverSettings mcSettings;
-    mcSettings.monteCarlo.samplesPerReceiver = 4096;
-    const Solution mc = Solve(prepared, mcSettings);
-    for (const BandAccuracy& band : CompareLeaves(scene, prepared.Flat(), mc, hrc))
-        std::printf("hrc vs mc: L2 %.3f %% mean rel %.3f %% floor %.3f\n", band.l2PctOfMax, band.meanRelativePct, band.referenceFloorPct);
-    for (const BandAccuracy& band : CompareLeaves(scene, prepared.Flat(), mc, instanced.solution))
-        std::printf("inst vs mc: L2 %.3f %% mean rel %.3f %%\n", band.l2PctOfMax, band.meanRelativePct);
-    const auto accuracy = CompareLeaves(scene, prepared.Flat(), hrc, instanced.solution);
-    for (const BandAccuracy& band : accuracy) {
-        std::printf("vs hrc: L2 %.3f %% mean rel %.3f %%\n", band.l2PctOfMax, band.meanRelativePct);
+        SolveInstanced(scene, prepared.Flat(), nullptr, none, database, options);
+    ASSERT_EQ(instanced.stats.depths.size(), 1u);
+    EXPECT_EQ(instanced.stats.originalsComputed, 0);
+    for (std::size_t r = 0; r < hrc.light.size(); ++r) {
+        for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+            EXPECT_DOUBLE_EQ(instanced.solution.light[r][b].irradianceUpperWm2,
+                             hrc.light[r][b].irradianceUpperWm2);
+            EXPECT_DOUBLE_EQ(instanced.solution.light[r][b].irradianceLowerWm2,
+                             hrc.light[r][b].irradianceLowerWm2);
+        }
     }
     for (std::size_t b = 0; b < scene.bands.size(); ++b) {
-        std::printf("balance hrc %g %g %g  inst %g %g %g\n", hrc.balance[b].incidentW,
-                    hrc.balance[b].absorbedW, hrc.balance[b].escapedW,
-                    instanced.solution.balance[b].incidentW,
-                    instanced.solution.balance[b].absorbedW,
-                    instanced.solution.balance[b].escapedW);
+        EXPECT_DOUBLE_EQ(instanced.solution.balance[b].incidentW, hrc.balance[b].incidentW);
+        EXPECT_DOUBLE_EQ(instanced.solution.balance[b].absorbedW, hrc.balance[b].absorbedW);
     }
 }
 
-}  // namespace
-}  // namespace leaflux
-namespace leaflux {
-TEST(InstancedExplore, Tree) {
-    if (!std::getenv("LEAVES")) GTEST_SKIP();
-    Scene scene;
-    scene.bands = {{"PAR"}, {"NIR"}};
-    scene.optics = {{"leaf", {{0.08, 0.06, 0.05, 0.05}, {0.45, 0.4, 0.45, 0.45}}},
-                    {"stem", {{0.1, 0.1, 0.0, 0.0}, {0.3, 0.3, 0.0, 0.0}}}};
-    TreeParameters tree;
-    tree.leafCount = std::atoi(std::getenv("LEAVES"));
-    AddTree(scene, tree, {0, 0, 0});
-    Sun sun = testing::SunAt(55.0, 140.0, 500.0);
-    sun.normalIrradianceWm2 = {500.0, 450.0};
-    scene.sources.suns.push_back(sun);
-    Sky sky;
-    sky.horizontalIrradianceWm2 = {90.0, 70.0};
-    scene.sources.skies.push_back(sky);
-    scene.Validate();
+// Four copies of a 120-leaf tree, 1.2 m apart and each turned, shading and lighting one
+// another: instantiated at the copies, their leaves get what the flattened scene's HRC
+// gives them, within what instancing approximates — the light each copy sends the others
+// by its phase function, and that light held per bin of 34 directions over each copy
+// (instanced.h). Measured: 0.37 / 1.0 % L2 (PAR / NIR) against HRC, whose own error
+// against Monte Carlo is 0.34 / 0.66 %; the bounds are twice and one and a half times that.
+TEST(Instanced, ExactCopiesLightTheirLeavesAsTheFlattenedScene) {
+    const Scene scene = Copies(4, 120);
     const PreparedScene prepared(scene);
-    SolverSettings flat;
-    flat.kind = SolverKind::kHrc;
-    flat.hrc.epsilon = std::getenv("EPS") ? std::atof(std::getenv("EPS")) : 1e-4;
-    const Solution hrc = Solve(prepared, flat);
+    const Solution hrc = Hrc(prepared, 1e-4);
     PhaseDatabase database({});
     InstancedOptions options;
-    options.hrc = flat.hrc;
-    InstancingPolicy policy;
-    policy.species = "t";
-    policy.instanceTypes = {NodeType::kAxis};
-    if (std::getenv("PLANT")) policy.instanceTypes.push_back(NodeType::kPlant);
-    policy.leafCount.edges = {1, 10, 100, 1000, 10000, 1e7};
-    policy.phase = {PhaseKind::kMonoDirectional, 3};
-    policy.transmittance = {PhaseKind::kMonoDirectional, 3};
-    const InstancedSolution instanced = SolveInstanced(scene, prepared.Flat(), std::getenv("TAU") ? nullptr : &prepared.Rays(), policy, database, options);
-    SolverSettings mcSettings;
-    mcSettings.monteCarlo.samplesPerReceiver = 1024;
-    const Solution mc = Solve(prepared, mcSettings);
-    for (const BandAccuracy& band : CompareLeaves(scene, prepared.Flat(), mc, hrc))
-        std::printf("hrc vs mc: L2 %.3f %% mean rel %.3f %% floor %.3f  %.2fs\n", band.l2PctOfMax, band.meanRelativePct, band.referenceFloorPct, hrc.stats.wallSeconds);
-    for (const BandAccuracy& band : CompareLeaves(scene, prepared.Flat(), mc, instanced.solution))
-        std::printf("inst vs mc: L2 %.3f %% mean rel %.3f %% %.2fs (orig %.2f)\n", band.l2PctOfMax, band.meanRelativePct, instanced.solution.stats.wallSeconds, instanced.stats.originalSeconds);
-    for (std::size_t d = 0; d < instanced.stats.depths.size(); ++d)
-        std::printf("depth %zu: %d instances\n", d, instanced.stats.depths[d].instances);
-    std::printf("originals %d\n", instanced.stats.originalsComputed);
+    options.hrc.epsilon = 1e-4;
+    const InstancedSolution instanced =
+        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+    EXPECT_EQ(instanced.stats.originalsComputed, 1);  // one original for the four
+    ASSERT_EQ(instanced.stats.depths.size(), 2u);
+    EXPECT_EQ(instanced.stats.depths[1].instances, 4);
+    EXPECT_EQ(instanced.stats.depths[1].opened, 4);
+    testing::ExpectFiniteLight(instanced.solution);
+    const auto accuracy = CompareLeaves(scene, prepared.Flat(), hrc, instanced.solution);
+    EXPECT_LT(accuracy[0].l2PctOfMax, 0.75);
+    EXPECT_LT(accuracy[1].l2PctOfMax, 1.5);
+    // What the leaves absorb: the copies' exchanges by phase function keep the power.
+    for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+        EXPECT_NEAR(instanced.solution.balance[b].absorbedW, hrc.balance[b].absorbedW,
+                    0.01 * hrc.balance[b].absorbedW);
+        EXPECT_NEAR(instanced.solution.balance[b].incidentW, hrc.balance[b].incidentW,
+                    0.005 * hrc.balance[b].incidentW);
+    }
 }
-}  // namespace leaflux
-namespace leaflux {
-TEST(InstancedExplore, SingleVsDirectional) {
-    const Scene scene = Copies(4, 120, 1.2);
+
+// Rigid motion of the whole scene: the same light, for instances carry their frames.
+TEST(Instanced, TheSceneMovedAndTurnedGetsTheSameLight) {
+    Scene scene = Copies(3, 60);
     const PreparedScene prepared(scene);
     PhaseDatabase database({});
     InstancedOptions options;
     options.hrc.epsilon = 1e-4;
-    const InstancedSolution a = SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
-    options.hrc.directionalInstances = false;
-    const InstancedSolution b = SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
-    double d = 0;
-    for (std::size_t r = 0; r < a.solution.light.size(); ++r) d = std::max(d, std::abs(a.solution.light[r][1].irradianceUpperWm2 - b.solution.light[r][1].irradianceUpperWm2));
-    std::printf("max diff %g\n", d);
-    for (auto& p : a.stats.problems) std::printf("problem depth %d tri %lld closed %lld elements %lld links %lld\n", p.depth, (long long)p.triangles, (long long)p.closed, (long long)p.elements, (long long)p.links);
+    const InstancedSolution here =
+        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+    // Turned a quarter about z (the sun and sky with it) and moved 50 m.
+    const glm::dmat4 motion =
+        glm::rotate(glm::translate(glm::dmat4(1.0), {50.0, -20.0, 0.0}), glm::half_pi<double>(),
+                    glm::dvec3(0, 0, 1));
+    for (Node& node : scene.nodes) {
+        if (node.parent == kNoParent) node.parentFromLocal = motion * node.parentFromLocal;
+    }
+    for (Sun& sun : scene.sources.suns)
+        sun.towardSun = glm::dvec3(motion * glm::dvec4(sun.towardSun, 0.0));
+    const PreparedScene moved(scene);
+    const InstancedSolution there =
+        SolveInstanced(scene, moved.Flat(), &moved.Rays(), Plants(), database, options);
+    // The uniform sky's cones do not turn with the scene: the scene is lit by another
+    // discretisation of the same sky, the links of another hierarchy.
+    const auto accuracy = CompareLeaves(scene, moved.Flat(), here.solution, there.solution);
+    EXPECT_LT(accuracy[0].l2PctOfMax, 1.0);
+    EXPECT_LT(accuracy[1].l2PctOfMax, 1.5);
 }
-}
+
+}  // namespace
+}  // namespace leaflux

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "solver/generate/generator.h"
+#include "server/policy_proto.h"
 #include "solver/solve.h"
 #include "solver/util/directions.h"
 #include "tests/scene_builders.h"
@@ -29,16 +30,19 @@ SolverSettings SettingsFor(SolverKind kind) {
     settings.monteCarlo.samplesPerReceiver = 1024;
     settings.monteCarlo.seed = 7;
     settings.hrc.epsilon = 1e-5;
+    settings.instanced.policy = DefaultPolicy();
     return settings;
 }
 
-const char* NameOf(SolverKind kind) { return kind == SolverKind::kHrc ? "hrc" : "mc"; }
+const char* NameOf(SolverKind kind) {
+    return kind == SolverKind::kHrc ? "hrc" : kind == SolverKind::kInstanced ? "instanced" : "mc";
+}
 
 // Solves, prints and records the iteration, residual and energy balance; checks that every
 // number is finite and non-negative.
 Solution SolveAndRecord(const PreparedScene& prepared, const SolverSettings& settings) {
     const Solution solution = Solve(prepared, settings);
-    if (settings.kind == SolverKind::kHrc) {  // converged, within its iteration budget
+    if (settings.kind != SolverKind::kMonteCarlo) {  // converged, within its iteration budget
         EXPECT_LE(solution.stats.residual, settings.hrc.tolerance);
         EXPECT_LT(solution.stats.iterations, settings.hrc.maxIterations);
     }
@@ -231,13 +235,14 @@ TEST_P(StiffStability, ClosedBoxAbsorbsAllTheLampEmits) {
     EXPECT_EQ(e.escapedW, 0.0);
     // What arrives first is all the lamp emits: Monte Carlo within its noise, HRC within
     // its links' error (the form factors of the lamp's patches at their centres).
-    EXPECT_NEAR(e.incidentW, lampW, kind == SolverKind::kHrc ? 0.005 * lampW : 4.6 * e.stderrW);
+    EXPECT_NEAR(e.incidentW, lampW, kind != SolverKind::kMonteCarlo ? 0.005 * lampW : 4.6 * e.stderrW);
     ExpectBalanced(solution, kind, 0.02);
 }
 
 INSTANTIATE_TEST_SUITE_P(EverySolver, StiffStability,
                          ::testing::Combine(::testing::Values(SolverKind::kMonteCarlo,
-                                                              SolverKind::kHrc),
+                                                              SolverKind::kHrc,
+                                                              SolverKind::kInstanced),
                                             ::testing::Values(0.9, 0.99, 0.999)),
                          [](const auto& param) {
                              const double scatter = std::get<1>(param.param);
@@ -270,7 +275,7 @@ TEST_P(Stability, LampOneMillimetreBelowALeaf) {
     const Solution solution = Run(scene);
     const BandLight& leaf = solution.light[0][0];
     const double lampWm2 = 1000.0 * 0.02 * 0.02 / (0.1 * 0.1);
-    if (Kind() == SolverKind::kHrc) {
+    if (Kind() != SolverKind::kMonteCarlo) {
         EXPECT_NEAR(leaf.irradianceLowerWm2, lampWm2, 0.01 * lampWm2);
         ExpectBalanced(solution, Kind());
         return;
@@ -402,7 +407,7 @@ TEST_P(Stability, OneLeaf) {
     // Monte Carlo within its noise; HRC's 46 sky cones sum the cosine of a horizontal
     // leaf to 1 % (their directions are the cones' centres).
     const double tolerance =
-        Kind() == SolverKind::kHrc ? 1e-6 * kSunWm2 + 0.01 * 100.0 : 4.6 * light.stderrUpperWm2;
+        Kind() != SolverKind::kMonteCarlo ? 1e-6 * kSunWm2 + 0.01 * 100.0 : 4.6 * light.stderrUpperWm2;
     EXPECT_NEAR(light.irradianceUpperWm2, 600.0, tolerance);
     EXPECT_EQ(light.irradianceLowerWm2, 0.0);
     EXPECT_NEAR(light.absorbedW, 0.85 * 600.0 * 0.02, 0.85 * 0.02 * tolerance);
@@ -431,7 +436,8 @@ TEST_P(Stability, ReflectanceEqualToTransmittance) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EverySolver, Stability,
-                         ::testing::Values(SolverKind::kMonteCarlo, SolverKind::kHrc),
+                         ::testing::Values(SolverKind::kMonteCarlo, SolverKind::kHrc,
+                                           SolverKind::kInstanced),
                          [](const auto& param) { return std::string(NameOf(param.param)); });
 
 }  // namespace

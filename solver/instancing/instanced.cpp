@@ -250,7 +250,12 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     for (std::size_t b = 0; b < solution.balance.size(); ++b) {
         solution.balance[b].absorbedW += light.solution.balance[b].absorbedW;
         solution.balance[b].incidentW += light.solution.balance[b].incidentW;
-        if (p == InstanceTree::kTop) solution.balance[b].escapedW += light.solution.balance[b].escapedW;
+        // What leaves the top's surfaces; not what opened instances send out of the scene,
+        // which their phase functions sent at the top (instanced.h).
+        if (p == InstanceTree::kTop) {
+            solution.balance[b].escapedW = light.solution.balance[b].escapedW;
+            solution.balance[b].stderrW = light.solution.balance[b].stderrW;
+        }
     }
     return light;
 }

@@ -296,8 +296,10 @@ void SceneSolve::OnSplit(std::uint32_t n) {
         sourceLight_.sides.Resize(size);
         sourceLight_.integral.Resize(size);
         sourceLight_.moment.Resize(size);
+        sourceLight_.beyond.Resize(size);
         for (std::uint32_t child : hierarchy_[n].children) {
             sourceLight_.sides.CopyRow(child, n);
+            sourceLight_.beyond.CopyRow(child, n);
             sourceLight_.integral.CopyRow(child, n);
             sourceLight_.moment.CopyRow(child, n);
         }
@@ -402,7 +404,14 @@ void SceneSolve::Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock)
             } else {
                 Collect<false>();
             }
-            if (iteration == 0) leafLight_.direct = leafLight_.irradiance;
+            if (iteration == 0) {
+                leafLight_.direct = leafLight_.irradiance;
+                // Light that arrived on an opened instance from the rest of the scene was
+                // incident there already: its balance counts the suns' and sky's alone.
+                if (std::any_of(sources_.begin(), sources_.end(),
+                                [](const DirectionalSource& s) { return !s.beyond; }))
+                    leafLight_.direct = sourceLight_.beyond;
+            }
             residual = options_.directOnly ? UpdateRadiosity(hierarchy_, traversal_.Leaves(),
                                                              optics_, leafLight_, field_)
                                            : Update();

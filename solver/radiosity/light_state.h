@@ -47,9 +47,13 @@ struct Gathered {
 
 struct SourceLight {
     explicit SourceLight(const Channels& channels)
-        : sides(channels.Count()), integral(channels.Count()), moment(channels.Count()) {}
+        : sides(channels.Count()),
+          beyond(channels.Count()),
+          integral(channels.Count()),
+          moment(channels.Count()) {}
 
     SideTable sides;
+    SideTable beyond;  // of it, what the sources beyond a local problem bring (its incident)
     Table<double> integral;
     Table<glm::dvec3> moment;
 };
