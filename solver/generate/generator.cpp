@@ -57,7 +57,6 @@ std::string GeneratedName(NodeType type, NodeId id) {
 NodeId AppendCopy(Scene& scene, std::size_t begin, std::size_t end, NodeId firstId, NodeId parent,
                   const glm::dmat4& parentFromLocal) {
     const NodeId from = scene.nodes[begin].id;
-    scene.nodes.reserve(scene.nodes.size() + (end - begin));
     for (std::size_t i = begin; i < end; ++i) {
         Node node = scene.nodes[i];
         LEAFLUX_CHECK_EQ(node.id, from + (i - begin));
