@@ -154,6 +154,8 @@ struct GenerateCommand {
     bool greenhouse = false;
     double lampPar = 1500.0, lampNir = 150.0;
     std::string skyCones = "continuous";
+    int prototypes = 4;
+    bool instanced = false;
     std::string out;
 };
 
@@ -181,6 +183,7 @@ int RunGenerate(const GenerateCommand& command) {
     plantation.rowSpacingM = command.rowSpacing > 0.0 ? command.rowSpacing : command.spacing;
     plantation.rowAzimuthDeg = command.rowAzimuth;
     plantation.jitterM = 0.1 * command.spacing;
+    plantation.prototypes = command.prototypes;
     if (command.randomCanopy) {
         CanopyParameters canopy = command.canopy;
         canopy.seed = command.tree.seed;
@@ -208,11 +211,17 @@ int RunGenerate(const GenerateCommand& command) {
                                        SkyDiscretizationNamed(command.skyCones)});
     }
     scene.Validate();
-    SaveSceneFile(scene, command.out);
-    std::size_t leaves = 0;
-    for (const Node& node : scene.nodes) leaves += node.type == NodeType::kLeaf;
+    SaveSceneFile(scene, command.out,
+                  command.instanced ? SceneWriting::kInstanced : SceneWriting::kFlat);
+    std::size_t leaves = 0, triangles = 0;
+    for (const Node& node : scene.nodes) {
+        leaves += node.type == NodeType::kLeaf;
+        if (node.organ) triangles += node.organ->mesh->triangles.size();
+    }
     std::cout << "wrote " << command.out << ": " << leaves << " leaves, " << scene.nodes.size()
-              << " nodes" << std::endl;
+              << " nodes, " << triangles << " organ triangles ("
+              << std::filesystem::file_size(command.out) << " bytes"
+              << (command.instanced ? ", instanced" : "") << ")" << std::endl;
     return 0;
 }
 
@@ -415,6 +424,22 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"continuous", "turtle46", "tetra34", "tetra130", "tetra514"}));
     generateApp->add_flag("!--internodes", generate.tree.internodes,
                           "No internode geometry (leaves only)");
+    generateApp->add_flag(
+        "--copies", generate.tree.copies,
+        "Exact self-similarity: the lateral axes of one order and leaf count are copies of one "
+        "prototype (the same organs in the axis's frame), and the trees copies of "
+        "--prototypes trees, each turned about z; for instancing tests, and with --instanced "
+        "for files that grow with the placements, not the polygons");
+    generateApp
+        ->add_option("--prototypes", generate.prototypes,
+                     "With --copies: prototype trees of a plantation (tree i is a copy of "
+                     "prototype i mod N)")
+        ->check(CLI::Range(1, 1'000'000));
+    generateApp->add_flag(
+        "--instanced", generate.instanced,
+        "Write subtrees that are exact copies once, as shared structures placed by a frame and "
+        "an id offset (Scene.structures, Scene.placements); leaflux solve reads the same scene "
+        "as from the flat file");
     generateApp->add_option("--out", generate.out, "Scene file to write")->required();
 
     ClientCommand client;

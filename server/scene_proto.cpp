@@ -10,6 +10,7 @@
 #include <sstream>
 #include <unordered_set>
 
+#include "server/scene_structures.h"
 #include "server/text_format.h"
 #include "solver/io/importers.h"
 #include "solver/util/error.h"
@@ -41,27 +42,6 @@ std::vector<double> PerBand(const Scene& scene,
     return result;
 }
 
-glm::dmat4 FrameFromProto(const v1::Frame& frame, const std::string& field,
-                          std::optional<NodeId> node = std::nullopt) {
-    if (frame.m_size() == 0) return glm::dmat4(1.0);
-    if (frame.m_size() != 12) {
-        Fail(ErrorCode::kInvalidArgument, field,
-             "needs 12 numbers (3×4 row-major), got " + std::to_string(frame.m_size()), node);
-    }
-    glm::dmat4 m(1.0);
-    for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 4; ++c) m[c][r] = frame.m(4 * r + c);
-    }
-    return m;
-}
-
-void FrameToProto(const glm::dmat4& m, v1::Frame* frame) {
-    if (m == glm::dmat4(1.0)) return;
-    for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 4; ++c) frame->add_m(m[c][r]);
-    }
-}
-
 std::shared_ptr<Mesh> MeshFromProto(const v1::Mesh& message, const std::string& field,
                                     std::optional<NodeId> node = std::nullopt) {
     if (message.positions_size() % 3 != 0) {
@@ -83,19 +63,6 @@ std::shared_ptr<Mesh> MeshFromProto(const v1::Mesh& message, const std::string& 
             {message.triangles(i), message.triangles(i + 1), message.triangles(i + 2)});
     }
     return mesh;
-}
-
-void MeshToProto(const Mesh& mesh, v1::Mesh* message) {
-    for (const glm::dvec3& p : mesh.positions) {
-        message->add_positions(p.x);
-        message->add_positions(p.y);
-        message->add_positions(p.z);
-    }
-    for (const glm::uvec3& t : mesh.triangles) {
-        message->add_triangles(t.x);
-        message->add_triangles(t.y);
-        message->add_triangles(t.z);
-    }
 }
 
 NodeType TypeFromProto(v1::NodeType type) {
@@ -149,6 +116,40 @@ v1::SkyDiscretization DiscretizationToProto(SkyDiscretization d) {
 }
 
 }  // namespace
+
+glm::dmat4 FrameFromProto(const v1::Frame& frame, const std::string& field,
+                          std::optional<NodeId> node) {
+    if (frame.m_size() == 0) return glm::dmat4(1.0);
+    if (frame.m_size() != 12) {
+        Fail(ErrorCode::kInvalidArgument, field,
+             "needs 12 numbers (3×4 row-major), got " + std::to_string(frame.m_size()), node);
+    }
+    glm::dmat4 m(1.0);
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 4; ++c) m[c][r] = frame.m(4 * r + c);
+    }
+    return m;
+}
+
+void FrameToProto(const glm::dmat4& m, v1::Frame* frame) {
+    if (m == glm::dmat4(1.0)) return;
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 4; ++c) frame->add_m(m[c][r]);
+    }
+}
+
+void MeshToProto(const Mesh& mesh, v1::Mesh* message) {
+    for (const glm::dvec3& p : mesh.positions) {
+        message->add_positions(p.x);
+        message->add_positions(p.y);
+        message->add_positions(p.z);
+    }
+    for (const glm::uvec3& t : mesh.triangles) {
+        message->add_triangles(t.x);
+        message->add_triangles(t.y);
+        message->add_triangles(t.z);
+    }
+}
 
 v1::NodeType TypeToProto(NodeType type) {
     switch (type) {
@@ -356,6 +357,7 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
                                     " nodes a session, got " +
                                     std::to_string(message.nodes_size()));
     }
+    CountPlacedNodes(message, static_cast<std::size_t>(message.nodes_size()), limits);
     const std::filesystem::path base(baseDirectory);
     Scene scene;
     std::unordered_set<std::string> bandNames;
@@ -390,6 +392,7 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
     }
     const MeshLibrary meshes = MeshesFromProto(message);
     for (const v1::Node& in : message.nodes()) scene.nodes.push_back(NodeFromProto(in, meshes));
+    ExpandPlacements(message, meshes, scene.nodes);
     for (const v1::Surface& surface : message.environment()) {
         scene.environment.push_back(
             {surface.name(),
@@ -406,7 +409,7 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
     return scene;
 }
 
-v1::Scene ToProto(const Scene& scene) {
+v1::Scene ToProto(const Scene& scene, SceneWriting writing) {
     v1::Scene message;
     message.set_version(v1::PROTOCOL_VERSION_CURRENT);
     for (const Band& band : scene.bands) {
@@ -426,32 +429,10 @@ v1::Scene ToProto(const Scene& scene) {
             values.set_tau_lower(optics.bands[b].tauLowerToUpper);
         }
     }
-    // A mesh used by more than one organ is written once and referenced.
-    std::map<const Mesh*, int> uses;
-    for (const Node& node : scene.nodes) {
-        if (node.organ) ++uses[node.organ->mesh.get()];
-    }
-    std::map<const Mesh*, std::string> names;
-    for (const Node& node : scene.nodes) {
-        v1::Node* n = message.add_nodes();
-        n->set_id(node.id);
-        n->set_parent(node.parent);
-        n->set_type(TypeToProto(node.type));
-        n->set_name(node.name);
-        FrameToProto(node.parentFromLocal, n->mutable_frame());
-        n->set_age(node.age);
-        n->mutable_attributes()->insert(node.attributes.begin(), node.attributes.end());
-        if (!node.organ) continue;
-        v1::Organ* organ = n->mutable_organ();
-        organ->set_optics(node.organ->opticsId);
-        const Mesh* mesh = node.organ->mesh.get();
-        if (uses[mesh] == 1) {
-            MeshToProto(*mesh, organ->mutable_mesh());
-            continue;
-        }
-        auto [it, added] = names.emplace(mesh, "mesh" + std::to_string(names.size()));
-        if (added) MeshToProto(*mesh, &(*message.mutable_meshes())[it->second]);
-        organ->set_mesh_ref(it->second);
+    if (writing == SceneWriting::kInstanced) {
+        WriteInstancedNodes(scene, message);
+    } else {
+        WriteFlatNodes(scene, message);
     }
     for (const Surface& surface : scene.environment) {
         v1::Surface* s = message.add_environment();
@@ -505,9 +486,9 @@ Scene LoadSceneFile(const std::string& path, const ImportOptions& options) {
     return FromProto(message, std::filesystem::path(path).parent_path().string(), {}, options);
 }
 
-void SaveSceneFile(const Scene& scene, const std::string& path) {
+void SaveSceneFile(const Scene& scene, const std::string& path, SceneWriting writing) {
     std::string text;
-    google::protobuf::TextFormat::PrintToString(ToProto(scene), &text);
+    google::protobuf::TextFormat::PrintToString(ToProto(scene, writing), &text);
     std::ofstream out(path);
     if (!out || !(out << text)) Fail(ErrorCode::kIo, path, "cannot write the scene file");
 }

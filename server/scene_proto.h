@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -59,12 +60,25 @@ Sun SunFromProto(const Scene& scene, const v1::Sun& sun, const std::string& fiel
 Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
                 const SceneLimits& limits = {}, const ImportOptions& options = {});
 
+// How a scene's nodes are written. kFlat: node by node. kInstanced: subtrees that occur
+// more than once as exact copies (server/scene_structures.h) are written once, in
+// `structures`, and placed by `placements`; reading either gives the same scene (its nodes
+// then in id order).
+enum class SceneWriting { kFlat, kInstanced };
+
 // Shared meshes stay shared: each distinct mesh is written once in `meshes`.
-v1::Scene ToProto(const Scene& scene);
+v1::Scene ToProto(const Scene& scene, SceneWriting writing = SceneWriting::kFlat);
 v1::NodeType TypeToProto(NodeType type);
+
+// Frames and meshes as the schema holds them; `field` and `node` name a bad frame.
+glm::dmat4 FrameFromProto(const v1::Frame& frame, const std::string& field,
+                          std::optional<NodeId> node = std::nullopt);
+void FrameToProto(const glm::dmat4& m, v1::Frame* frame);  // nothing for the identity
+void MeshToProto(const Mesh& mesh, v1::Mesh* message);
 
 // Reads a scene file in protobuf text format; parse errors name line and column.
 Scene LoadSceneFile(const std::string& path, const ImportOptions& options = {});
-void SaveSceneFile(const Scene& scene, const std::string& path);
+void SaveSceneFile(const Scene& scene, const std::string& path,
+                   SceneWriting writing = SceneWriting::kFlat);
 
 }  // namespace leaflux

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/gtc/constants.hpp>
+#include <map>
+#include <utility>
 
 #include "solver/scene/geometry.h"
 #include "solver/util/check.h"
@@ -33,6 +35,43 @@ glm::dvec3 AnyPerpendicular(const glm::dvec3& a) {
 glm::dvec3 Rotate(const glm::dvec3& v, const glm::dvec3& k, double angle) {
     return v * std::cos(angle) + glm::cross(k, v) * std::sin(angle) +
            k * glm::dot(k, v) * (1.0 - std::cos(angle));
+}
+
+// The frame of an axis starting at the origin of `worldFromParent`, z along `direction`.
+glm::dmat4 AxisFrame(const glm::dmat4& worldFromParent, const glm::dvec3& direction) {
+    const glm::dvec3 base(worldFromParent[3]);
+    const glm::dvec3 side = AnyPerpendicular(direction);
+    return FrameOf(base, side, glm::cross(direction, side), direction);
+}
+
+// The generated name of a node, "<type><id>".
+std::string GeneratedName(NodeType type, NodeId id) {
+    return NodeTypeName(type) + std::to_string(id);
+}
+
+// Appends a copy of scene.nodes[begin, end): a subtree rooted at nodes[begin] whose ids run
+// contiguously from the root's, as the generator makes them. The copy's ids run from
+// `firstId`, its root hangs from `parent` at `parentFromLocal`, every other node keeps its
+// frame: the copy is exact in its root's frame. Generated names follow the new ids. Returns
+// the next free id.
+NodeId AppendCopy(Scene& scene, std::size_t begin, std::size_t end, NodeId firstId, NodeId parent,
+                  const glm::dmat4& parentFromLocal) {
+    const NodeId from = scene.nodes[begin].id;
+    for (std::size_t i = begin; i < end; ++i) {
+        Node node = scene.nodes[i];
+        LEAFLUX_CHECK_EQ(node.id, from + (i - begin));
+        const bool generatedName = node.name == GeneratedName(node.type, node.id);
+        node.id = node.id - from + firstId;
+        if (i == begin) {
+            node.parent = parent;
+            node.parentFromLocal = parentFromLocal;
+        } else {
+            node.parent = node.parent - from + firstId;
+        }
+        if (generatedName) node.name = GeneratedName(node.type, node.id);
+        scene.nodes.push_back(std::move(node));
+    }
+    return firstId + (end - begin);
 }
 
 std::shared_ptr<const Mesh> LeafPrototype() {
@@ -110,11 +149,29 @@ class TreeBuilder {
         return scene_.nodes.back().id;
     }
 
+    // A lateral axis in copies mode: a copy of the prototype of its depth and leaf count, the
+    // prototype drawn (from a stream of that class) where the first of them grows.
+    void CopiedAxis(NodeId parent, const glm::dmat4& worldFromParent, const glm::dvec3& direction,
+                    int depth, long leaves) {
+        const std::pair<int, long> key(depth, leaves);
+        if (const auto it = prototypes_.find(key); it != prototypes_.end()) {
+            next_ =
+                AppendCopy(scene_, it->second.first, it->second.second, next_, parent,
+                           glm::inverse(worldFromParent) * AxisFrame(worldFromParent, direction));
+            return;
+        }
+        const std::size_t begin = scene_.nodes.size();
+        Random random(StreamSeed(p_.seed, 0xC0B1E5 + static_cast<std::uint64_t>(depth),
+                                 static_cast<std::uint64_t>(leaves)));
+        Axis(parent, worldFromParent, direction, depth, leaves, random);
+        prototypes_[key] = {begin, scene_.nodes.size()};
+    }
+
     void Axis(NodeId parent, const glm::dmat4& worldFromParent, const glm::dvec3& direction,
               int depth, long leaves, Random& random) {
         const glm::dvec3 base(worldFromParent[3]);
         const glm::dvec3 side = AnyPerpendicular(direction);
-        const glm::dmat4 world = FrameOf(base, side, glm::cross(direction, side), direction);
+        const glm::dmat4 world = AxisFrame(worldFromParent, direction);
         Node axis;
         axis.type = NodeType::kAxis;
         axis.age = depth;
@@ -163,6 +220,10 @@ class TreeBuilder {
             const double angle = glm::radians(p_.branchAngleDeg + 10.0 * (random.Uniform() - 0.5));
             const glm::dvec3 lateral =
                 glm::normalize(std::cos(angle) * direction + std::sin(angle) * around);
+            if (p_.copies) {
+                CopiedAxis(phytomerId, phytomerWorld, lateral, depth + 1, here);
+                continue;
+            }
             Random childRandom(StreamSeed(p_.seed, next_));
             Axis(phytomerId, FrameOf(at, side, glm::cross(direction, side), direction), lateral,
                  depth + 1, here, childRandom);
@@ -198,6 +259,8 @@ class TreeBuilder {
     int depth_ = 0;
     int branching_ = 1;
     double trunkLengthM_ = 1.0;
+    // Copies mode: (depth, leaves) → the prototype's range in scene_.nodes.
+    std::map<std::pair<int, long>, std::pair<std::size_t, std::size_t>> prototypes_;
 };
 
 }  // namespace
@@ -258,7 +321,12 @@ void AddPlantation(Scene& scene, const PlantationParameters& parameters,
     const PlantationFrame frame(parameters);
     NodeId next = 1;
     for (const Node& node : scene.nodes) next = std::max(next, node.id + 1);
+    if (parameters.tree.copies && parameters.prototypes < 1) {
+        throw InputError(ErrorCode::kInvalidArgument, "prototypes", "needs at least one");
+    }
     Random jitter(StreamSeed(parameters.tree.seed, 0xB0A7));
+    Random turn(StreamSeed(parameters.tree.seed, 0x7E11));        // copies' azimuths
+    std::vector<std::pair<std::size_t, std::size_t>> prototypes;  // ranges in scene.nodes
     const int trees =
         parameters.trees > 0 ? parameters.trees : parameters.rows * parameters.columns;
     for (int r = 0, placed = 0; r < parameters.rows; ++r) {
@@ -267,9 +335,22 @@ void AddPlantation(Scene& scene, const PlantationParameters& parameters,
                              parameters.jitterM * (2.0 * jitter.Uniform() - 1.0);
             const double y = (r - 0.5 * (parameters.rows - 1)) * parameters.rowSpacingM +
                              parameters.jitterM * (2.0 * jitter.Uniform() - 1.0);
+            const glm::dvec3 base = x * frame.along + y * frame.across;
+            const std::size_t prototype =
+                parameters.tree.copies ? placed % parameters.prototypes : prototypes.size();
+            if (prototype < prototypes.size()) {
+                const double azimuth = 2.0 * glm::pi<double>() * turn.Uniform();
+                const glm::dvec3 east(std::cos(azimuth), std::sin(azimuth), 0.0);
+                next = AppendCopy(scene, prototypes[prototype].first, prototypes[prototype].second,
+                                  next, kNoParent,
+                                  FrameOf(base, east, {-east.y, east.x, 0.0}, {0, 0, 1}));
+                continue;
+            }
             TreeParameters tree = parameters.tree;
             tree.seed = StreamSeed(parameters.tree.seed, r, c);
-            next = AddTree(scene, tree, x * frame.along + y * frame.across, next);
+            const std::size_t begin = scene.nodes.size();
+            next = AddTree(scene, tree, base, next);
+            if (parameters.tree.copies) prototypes.emplace_back(begin, scene.nodes.size());
         }
     }
     if (groundOptics.empty()) return;

@@ -7,6 +7,12 @@
 // Node types: plant → axis → phytomer → (internode, leaf, axis). Leaves share one
 // prototype mesh and internodes another; each organ is placed, turned and scaled by its
 // node's frame (z along the structure's main axis), so the output is instancing data.
+//
+// With `copies`, the self-similarity is made exact: the lateral axes of one order and one
+// leaf count are copies of one prototype (the same nodes, frames and organs below the axis,
+// in the axis's frame), placed by their axis frame alone; a plantation's trees are then
+// copies of a few prototype trees. Such a scene is what instancing == flattening is tested
+// on, and what `SceneWriting::kInstanced` writes small.
 #pragma once
 
 #include <cstdint>
@@ -27,6 +33,10 @@ struct TreeParameters {
     double leafInclinationDeg = 35.0;  // mean angle of the blade to the horizontal
     bool internodes = true;            // give internodes geometry (opaque prisms), but on the
                                        // leafy shoots, whose twigs stay bare topology
+    // Lateral axes of one order and leaf count are exact copies of one prototype (its nodes'
+    // ids contiguous, like every subtree the generator makes). Off: every axis drawn anew,
+    // the default tree unchanged.
+    bool copies = false;
     std::string leafOptics = "leaf";
     std::string stemOptics = "stem";
 };
@@ -43,9 +53,13 @@ struct PlantationParameters {
     double rowSpacingM = 5.0, columnSpacingM = 5.0;
     double jitterM = 0.5;        // uniform random offset of each tree, in x and y
     double rowAzimuthDeg = 0.0;  // direction of the rows, from north clockwise
+    // With tree.copies: the trees are exact copies of this many prototype trees (tree i of
+    // prototype i mod prototypes), each copy turned about z by a random azimuth.
+    int prototypes = 4;
 };
 
-// rows × columns trees (each seeded from the tree seed and its position), centred on the
+// rows × columns trees (each seeded from the tree seed and its position; with tree.copies,
+// copies of `prototypes` trees), centred on the
 // origin, on a ground rectangle of the plantation's extent (optics `groundOptics`; none
 // when empty). Returns the scene's bands and optics untouched: the caller declares them.
 void AddPlantation(Scene& scene, const PlantationParameters& parameters,
