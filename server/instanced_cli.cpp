@@ -15,13 +15,15 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
                      "instanced: instantiation policy file (protobuf text format, "
                      "leaflux.v1.InstancingPolicy); default: the built-in general policy, "
                      "plants and axes by their leaf count in orders of magnitude");
-    solve.add_option("--phase-db", command.phaseDb,
-                     "instanced: phase-function database file, read and extended")
+    solve
+        .add_option("--phase-db", command.phaseDb,
+                    "instanced: phase-function database file, read and extended")
         ->capture_default_str();
     solve.add_flag("--no-phase-db", command.noPhaseDb,
                    "instanced: keep the phase functions in memory only");
-    solve.add_option("--phase-db-mb", command.phaseDbMb,
-                     "instanced: the database's buffer in memory (MB)")
+    solve
+        .add_option("--phase-db-mb", command.phaseDbMb,
+                    "instanced: the database's buffer in memory (MB)")
         ->capture_default_str()
         ->check(CLI::Range(1.0, 1e6));
     solve
@@ -58,9 +60,10 @@ Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene*
     std::printf("instances by depth (opened):");
     for (std::size_t d = 1; d < stats.depths.size(); ++d)
         std::printf(" %zu: %d (%d)", d, stats.depths[d].instances, stats.depths[d].opened);
-    std::printf("\nphase functions: %d computed in %.2f s, %d reused; solving %.2f s; peak %.1f MiB\n",
-                stats.originalsComputed, stats.originalSeconds, stats.originalsReused,
-                stats.solveSeconds, stats.peakRssBytes / 1048576.0);
+    std::printf(
+        "\nphase functions: %d computed in %.2f s, %d reused; solving %.2f s; peak %.1f MiB\n",
+        stats.originalsComputed, stats.originalSeconds, stats.originalsReused, stats.solveSeconds,
+        stats.peakRssBytes / 1048576.0);
     if (!command.problems.empty()) {
         std::ofstream out(command.problems);
         if (!out) throw InputError(ErrorCode::kIo, command.problems, "cannot write");

@@ -15,16 +15,16 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <optional>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "server/bench_error.h"
 #include "server/client.h"
 #include "server/instanced_cli.h"
 #include "server/phase_db_cli.h"
-#include "server/policy_proto.h"
 #include "server/policy_cli.h"
+#include "server/policy_proto.h"
 #include "server/scene_proto.h"
 #include "solver/generate/generator.h"
 #include "solver/results/export.h"
@@ -109,10 +109,10 @@ int RunSolve(const SolveCommand& command) {
             }
         };
     }
-    const Solution solution =
-        instanced ? RunInstanced(scene, flat, whole ? &prepared->Rays() : nullptr, settings.hrc,
-                                 command.instanced)
-                  : Solve(*prepared, settings);
+    const Solution solution = instanced
+                                  ? RunInstanced(scene, flat, whole ? &prepared->Rays() : nullptr,
+                                                 settings.hrc, command.instanced)
+                                  : Solve(*prepared, settings);
     std::ofstream leaves(command.out);
     if (!leaves) throw InputError(ErrorCode::kIo, command.out, "cannot write");
     WriteLeafCsv(leaves, scene, flat, solution);
@@ -330,11 +330,11 @@ int main(int argc, char** argv) {
             "instances of shared phase functions, one at a time)")
         ->check(CLI::IsMember({"mc", "hrc", "instanced"}));
     solveApp
-        ->add_option(
-            "--epsilon", solve.epsilon,
-            "hrc, instanced: largest error of a link, as a fraction of the power the suns and sky bring "
-            "onto the organs (plus the lamps' power); surfaces far from the organs are "
-            "allowed more by the square of their distance")
+        ->add_option("--epsilon", solve.epsilon,
+                     "hrc, instanced: largest error of a link, as a fraction of the power the suns "
+                     "and sky bring "
+                     "onto the organs (plus the lamps' power); surfaces far from the organs are "
+                     "allowed more by the square of their distance")
         ->check(CLI::Range(1e-9, 1.0));
     AddHrcSettings(*solveApp, solve.hrc, "--", "hrc, instanced: ");
     AddInstancedOptions(*solveApp, solve.instanced);
@@ -584,6 +584,9 @@ int main(int argc, char** argv) {
         if (clientApp->parsed()) return RunClient(client, request);
     } catch (const InputError& e) {
         spdlog::error("{}", e.what());
+        return 2;
+    } catch (const TooLarge& e) {  // a scene over the limits a solve accepts
+        spdlog::error("{}: {}", e.Field(), e.what());
         return 2;
     } catch (const std::exception& e) {
         spdlog::error("internal error: {}", e.what());

@@ -1,8 +1,8 @@
 #include "server/policy_proto.h"
 
-#include <array>
-
 #include <google/protobuf/text_format.h>
+
+#include <array>
 
 #include "server/default_policy.h"
 #include "server/scene_proto.h"

@@ -41,10 +41,10 @@ Solution Solve(const PreparedScene& prepared, const SolverSettings& settings) {
             PhaseDatabase* database = instanced.database;
             if (database == nullptr) database = &own.emplace(PhaseDatabaseOptions{});
             InstancedOptions options{settings.hrc, instanced.originals};
-            InstancedSolution solved = SolveInstanced(
-                prepared.Source(), prepared.Flat(),
-                instanced.shadowsByGeometry ? &prepared.Rays() : nullptr, instanced.policy,
-                *database, options);
+            InstancedSolution solved =
+                SolveInstanced(prepared.Source(), prepared.Flat(),
+                               instanced.shadowsByGeometry ? &prepared.Rays() : nullptr,
+                               instanced.policy, *database, options);
             if (instanced.stats != nullptr) *instanced.stats = std::move(solved.stats);
             return std::move(solved.solution);
         }

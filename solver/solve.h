@@ -17,7 +17,7 @@ enum class SolverKind { kMonteCarlo, kHrc, kInstanced };
 // The instanced solver's: its policy, the database its originals come from and go to,
 // and what direct light meets (instanced.h). Its radiosity settings are `hrc`'s.
 struct InstancedSettings {
-    InstancingPolicy policy;           // required: a policy with an instance type
+    InstancingPolicy policy;            // required: a policy with an instance type
     PhaseDatabase* database = nullptr;  // null: one in memory for this solve
     OriginalSettings originals;
     bool shadowsByGeometry = true;

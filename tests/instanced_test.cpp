@@ -29,8 +29,8 @@ Scene Copies(int copies, int leaves, double spacing = 1.2) {
         Node& root = scene.nodes[first];
         EXPECT_EQ(root.parent, kNoParent);
         root.parentFromLocal =
-            glm::rotate(glm::translate(glm::dmat4(1.0), {spacing * c, 0.25 * spacing * c, 0.0}), 0.9 * c,
-                        glm::dvec3(0, 0, 1)) *
+            glm::rotate(glm::translate(glm::dmat4(1.0), {spacing * c, 0.25 * spacing * c, 0.0}),
+                        0.9 * c, glm::dvec3(0, 0, 1)) *
             root.parentFromLocal;
     }
     Sun sun = testing::SunAt(55.0, 140.0, 500.0);
@@ -130,9 +130,8 @@ TEST(Instanced, TheSceneMovedAndTurnedGetsTheSameLight) {
     const InstancedSolution here =
         SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
     // Turned a quarter about z (the sun and sky with it) and moved 50 m.
-    const glm::dmat4 motion =
-        glm::rotate(glm::translate(glm::dmat4(1.0), {50.0, -20.0, 0.0}), glm::half_pi<double>(),
-                    glm::dvec3(0, 0, 1));
+    const glm::dmat4 motion = glm::rotate(glm::translate(glm::dmat4(1.0), {50.0, -20.0, 0.0}),
+                                          glm::half_pi<double>(), glm::dvec3(0, 0, 1));
     for (Node& node : scene.nodes) {
         if (node.parent == kNoParent) node.parentFromLocal = motion * node.parentFromLocal;
     }

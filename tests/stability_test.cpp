@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "solver/generate/generator.h"
 #include "server/policy_proto.h"
+#include "solver/generate/generator.h"
 #include "solver/solve.h"
 #include "solver/util/directions.h"
 #include "tests/scene_builders.h"
@@ -235,7 +235,8 @@ TEST_P(StiffStability, ClosedBoxAbsorbsAllTheLampEmits) {
     EXPECT_EQ(e.escapedW, 0.0);
     // What arrives first is all the lamp emits: Monte Carlo within its noise, HRC within
     // its links' error (the form factors of the lamp's patches at their centres).
-    EXPECT_NEAR(e.incidentW, lampW, kind != SolverKind::kMonteCarlo ? 0.005 * lampW : 4.6 * e.stderrW);
+    EXPECT_NEAR(e.incidentW, lampW,
+                kind != SolverKind::kMonteCarlo ? 0.005 * lampW : 4.6 * e.stderrW);
     ExpectBalanced(solution, kind, 0.02);
 }
 
@@ -406,8 +407,8 @@ TEST_P(Stability, OneLeaf) {
     const BandLight& light = solution.light[0][0];
     // Monte Carlo within its noise; HRC's 46 sky cones sum the cosine of a horizontal
     // leaf to 1 % (their directions are the cones' centres).
-    const double tolerance =
-        Kind() != SolverKind::kMonteCarlo ? 1e-6 * kSunWm2 + 0.01 * 100.0 : 4.6 * light.stderrUpperWm2;
+    const double tolerance = Kind() != SolverKind::kMonteCarlo ? 1e-6 * kSunWm2 + 0.01 * 100.0
+                                                               : 4.6 * light.stderrUpperWm2;
     EXPECT_NEAR(light.irradianceUpperWm2, 600.0, tolerance);
     EXPECT_EQ(light.irradianceLowerWm2, 0.0);
     EXPECT_NEAR(light.absorbedW, 0.85 * 600.0 * 0.02, 0.85 * 0.02 * tolerance);

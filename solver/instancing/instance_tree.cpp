@@ -44,13 +44,15 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
             parts_.push_back(std::move(instance));
         }
         owner[i] = part;
-        for (auto c = children[i].rbegin(); c != children[i].rend(); ++c) stack.push_back({*c, part});
+        for (auto c = children[i].rbegin(); c != children[i].rend(); ++c)
+            stack.push_back({*c, part});
     }
     for (std::size_t i = 0; i < count; ++i) {
         Part& part = parts_[owner[i]];
         part.nodes.push_back(i);
         const Node& node = scene.nodes[i];
-        if (node.organ) part.triangles += static_cast<std::int64_t>(node.organ->mesh->triangles.size());
+        if (node.organ)
+            part.triangles += static_cast<std::int64_t>(node.organ->mesh->triangles.size());
         if (owner[i] != kTop && parts_[owner[i]].root == node.id)
             parts_[part.parent].instances.push_back(owner[i]);
     }
@@ -71,7 +73,8 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
                     lo = glm::min(lo, q);
                     hi = glm::max(hi, q);
                 }
-                part.leafAreaM2 += MeshArea(*node.organ->mesh, worldFromInstance * instanceFromNode);
+                part.leafAreaM2 +=
+                    MeshArea(*node.organ->mesh, worldFromInstance * instanceFromNode);
             }
             for (std::size_t c : children[i])
                 walk.push_back({c, instanceFromNode * scene.nodes[c].parentFromLocal});

@@ -5,10 +5,10 @@
 
 #include <algorithm>
 #include <chrono>
-#include <tuple>
 #include <glm/gtc/matrix_transform.hpp>
 #include <mutex>
 #include <numbers>
+#include <tuple>
 #include <unordered_map>
 
 #include "solver/instancing/instance_tree.h"
@@ -17,8 +17,8 @@
 #include "solver/instancing/signature.h"
 #include "solver/raytrace/occlusion.h"
 #include "solver/scene/geometry.h"
-#include "solver/util/directions.h"
 #include "solver/util/check.h"
+#include "solver/util/directions.h"
 #include "solver/util/error.h"
 #include "solver/util/memory.h"
 
@@ -32,9 +32,8 @@ class MemberContents : public ClosedContents {
   public:
     MemberContents(std::shared_ptr<const Original> original, double areaM2)
         : original_(std::move(original)),
-          scale_(original_->provenance.leafAreaM2 > 0.0
-                     ? areaM2 / original_->provenance.leafAreaM2
-                     : 1.0) {}
+          scale_(original_->provenance.leafAreaM2 > 0.0 ? areaM2 / original_->provenance.leafAreaM2
+                                                        : 1.0) {}
     double Transmittance(const glm::dvec3& omega) const override {
         return original_->transmittance.Value(omega, 0);
     }
@@ -87,7 +86,8 @@ class InstancedSolve {
                                    std::vector<BandLight>(scene.bands.size()));
         out_.solution.balance.assign(scene.bands.size(), EnergyBalance{});
         out_.stats.depths.assign(tree.Depth() + 1, InstancedStats::Depth{});
-        for (const InstanceTree::Part& part : tree.Parts()) ++out_.stats.depths[part.depth].instances;
+        for (const InstanceTree::Part& part : tree.Parts())
+            ++out_.stats.depths[part.depth].instances;
         out_.stats.depths[0].opened = 1;
     }
 
@@ -104,7 +104,8 @@ class InstancedSolve {
 
     std::unique_ptr<Level> Build(std::uint32_t p, const glm::dmat4& worldFromRoot,
                                  const Level* outside, std::uint32_t indexOutside) const;
-    LevelSolution Solve(std::uint32_t p, const Level& level, std::vector<DirectionalSource> sources);
+    LevelSolution Solve(std::uint32_t p, const Level& level,
+                        std::vector<DirectionalSource> sources);
     // The scene's receiver that a level's receiver is.
     std::uint32_t Global(const FlatScene& flat, std::uint32_t r) const {
         const Receiver& receiver = flat.receivers[r];
@@ -196,7 +197,8 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
     for (const ClosedNode& closed : level->closed) proxies.push_back(closed.Proxy());
     OutsideView view;
     if (outside != nullptr) {
-        view = {outside->occlusion.get(), {indexOutside}, level->flat.origin - outside->flat.origin};
+        view = {
+            outside->occlusion.get(), {indexOutside}, level->flat.origin - outside->flat.origin};
     }
     level->occlusion = std::make_unique<Occlusion>(*level->rays, std::move(proxies),
                                                    std::move(view), ShadowsOf(level->flat));
@@ -245,7 +247,8 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     solution.stats.rays += light.solution.stats.rays;
     solution.stats.links = std::max(solution.stats.links, light.solution.stats.links);
     solution.stats.elements = std::max(solution.stats.elements, light.solution.stats.elements);
-    solution.stats.iterations = std::max(solution.stats.iterations, light.solution.stats.iterations);
+    solution.stats.iterations =
+        std::max(solution.stats.iterations, light.solution.stats.iterations);
     solution.stats.residual = std::max(solution.stats.residual, light.solution.stats.residual);
     for (std::size_t b = 0; b < solution.balance.size(); ++b) {
         solution.balance[b].absorbedW += light.solution.balance[b].absorbedW;
@@ -283,10 +286,10 @@ std::vector<DirectionalSource> InstancedSolve::ArrivedOn(const LevelSolution& li
         }
     }
     for (int d = 0; d < light.bins; ++d) {
-        DirectionalSource cone{directions_.Direction(d),
-                               std::vector<double>(bins.begin() + d * channels,
-                                                   bins.begin() + (d + 1) * channels),
-                               1.0 - directions_.HatIntegralSr(d) / (2.0 * std::numbers::pi)};
+        DirectionalSource cone{
+            directions_.Direction(d),
+            std::vector<double>(bins.begin() + d * channels, bins.begin() + (d + 1) * channels),
+            1.0 - directions_.HatIntegralSr(d) / (2.0 * std::numbers::pi)};
         cone.beyond = false;
         double total = 0.0;
         for (double e : cone.normalIrradiance) total += e;
@@ -299,9 +302,8 @@ void InstancedSolve::OpenInstances(const Level& level, const LevelSolution& ligh
     std::vector<std::vector<DirectionalSource>> arrived(level.closed.size());
     for (std::size_t c = 0; c < level.closed.size(); ++c) arrived[c] = ArrivedOn(light, c);
     // Siblings are independent once their parent is solved: each its own problem.
-    tbb::parallel_for(std::size_t{0}, level.closed.size(), [&](std::size_t c) {
-        Open(level, c, std::move(arrived[c]));
-    });
+    tbb::parallel_for(std::size_t{0}, level.closed.size(),
+                      [&](std::size_t c) { Open(level, c, std::move(arrived[c])); });
 }
 
 void InstancedSolve::Open(const Level& parent, std::size_t c,

@@ -74,8 +74,8 @@ struct InstancedSolution {
 // light from the suns and sky cones then meets instead of the closed instances' τ (exact
 // shadows, for the memory of the whole scene's triangles). Throws InputError
 // (kUnsupported) for a periodic scene.
-InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& flat,
-                                 const RayScene* shadows, const InstancingPolicy& policy,
-                                 PhaseDatabase& database, const InstancedOptions& options);
+InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& flat, const RayScene* shadows,
+                                 const InstancingPolicy& policy, PhaseDatabase& database,
+                                 const InstancedOptions& options);
 
 }  // namespace leaflux

@@ -49,12 +49,15 @@ SceneOriginals OriginalsOf(const Scene& scene, const SceneSignatures& signatures
     const OriginalSettings settings = SettingsOf(policy, accuracy);
     SceneOriginals originals;
     for (const SignatureGroup& group : signatures.groups) {
-        const PhaseKey key = KeyOf(policy.species, policy, group.signature, scene, settings);
+        OriginalSettings own = settings;
+        if (own.method == PhaseMethod::kRadiosity &&
+            signatures.Find(group.representative)->leafCount > own.radiosityLeavesAtMost)
+            own.method = PhaseMethod::kPhotons;
+        const PhaseKey key = KeyOf(policy.species, policy, group.signature, scene, own);
         double seconds = 0.0;
         const PhaseLookup lookup = database.GetOrCompute(key, [&] {
             const auto start = std::chrono::steady_clock::now();
-            Original original =
-                ComputeOriginal(StructureAlone(scene, group.representative), settings);
+            Original original = ComputeOriginal(StructureAlone(scene, group.representative), own);
             seconds =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             return original;

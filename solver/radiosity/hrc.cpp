@@ -193,9 +193,9 @@ class SceneSolve {
             UpdateRadiosity(hierarchy_, traversal_.Leaves(), optics_, leafLight_, field_);
         if (Closed()) {
             if (!closedResponse_) closedResponse_.emplace(model_, sources_);
-            residual = std::max(residual,
-                                ScatterClosed(model_, sources_, *closedResponse_, closedLight_,
-                                              options_.directionalInstances, field_));
+            residual =
+                std::max(residual, ScatterClosed(model_, sources_, *closedResponse_, closedLight_,
+                                                 options_.directionalInstances, field_));
         }
         return residual;
     }

@@ -128,12 +128,12 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
             total += weights[i];
             if (closed[i] >= 0) {
                 const std::int32_t ends[2] = {closed[i], -1};
-                visible += weights[i] * occlusion_.Transmittance(starts[i], directions[i],
-                                                                 INFINITY, Exclusion(ends));
+                visible += weights[i] * occlusion_.Transmittance(starts[i], directions[i], INFINITY,
+                                                                 Exclusion(ends));
                 continue;
             }
-            whole.push_back({starts[i].origin + shadows.offset,
-                             shadows.triangleOf[starts[i].triangle]});
+            whole.push_back(
+                {starts[i].origin + shadows.offset, shadows.triangleOf[starts[i].triangle]});
             wholeDirections.push_back(directions[i]);
             wholeWeights.push_back(weights[i]);
         }
@@ -160,11 +160,11 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
     for (std::size_t i = 0; i < starts.size(); ++i) {
         const std::int32_t ends[2] = {closed[i], -1};
         total += weights[i];
-        visible += weights[i] * (light.beyond ? occlusion_.Transmittance(starts[i], directions[i],
-                                                                         INFINITY, Exclusion(ends))
-                                              : occlusion_.LocalTransmittance(
-                                                    starts[i], directions[i], INFINITY,
-                                                    Exclusion(ends)));
+        visible +=
+            weights[i] * (light.beyond ? occlusion_.Transmittance(starts[i], directions[i],
+                                                                  INFINITY, Exclusion(ends))
+                                       : occlusion_.LocalTransmittance(starts[i], directions[i],
+                                                                       INFINITY, Exclusion(ends)));
     }
     return total > 0.0 ? visible / total : 0.0;
 }

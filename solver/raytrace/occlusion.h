@@ -88,8 +88,8 @@ class Occlusion {
         if (local <= 0.0 || outside_.occlusion == nullptr) return local;
         // Nothing of the local problem is in the outside's scene: no triangle to skip.
         const RayStart there{start.origin + outside_.offset};
-        return local * outside_.occlusion->Transmittance(there, direction, maxDistance,
-                                                         outside_.exclude);
+        return local *
+               outside_.occlusion->Transmittance(there, direction, maxDistance, outside_.exclude);
     }
     // The same through the local problem's own triangles and closed instances alone.
     double LocalTransmittance(const RayStart& start, const glm::dvec3& direction,

@@ -55,8 +55,8 @@ FlatScene ReceiversOf(const Scene& scene) {
         flat.receivers.back().areaM2 = MeshArea(*node.organ->mesh, worldFromLocal.at(node.id));
     }
     for (const Surface& surface : scene.environment) {
-        flat.receivers.push_back({surface.name, ReceiverKind::kEnvironment, 0,
-                                  scene.OpticsIndex(surface.opticsId)});
+        flat.receivers.push_back(
+            {surface.name, ReceiverKind::kEnvironment, 0, scene.OpticsIndex(surface.opticsId)});
         flat.receivers.back().areaM2 = MeshArea(*surface.mesh, glm::dmat4(1.0));
     }
     for (std::size_t e = 0; e < scene.sources.emitters.size(); ++e) {
