@@ -106,16 +106,19 @@ class InstancedSolve {
                                  const Level* outside, std::uint32_t indexOutside) const;
     LevelSolution Solve(std::uint32_t p, const Level& level,
                         std::vector<DirectionalSource> sources);
-    // The scene's receiver that a level's receiver is.
-    std::uint32_t Global(const FlatScene& flat, std::uint32_t r) const {
+    // The scene's receiver that receiver r of a level with `organs` organ receivers is:
+    // environment surfaces and emitters are the top's, after its organs, in order.
+    std::uint32_t Global(const FlatScene& flat, std::uint32_t organs, std::uint32_t r) const {
         const Receiver& receiver = flat.receivers[r];
         if (receiver.kind == ReceiverKind::kOrgan) return organReceiver_.at(receiver.node);
-        // Environment surfaces and emitters are the top's, after its organs, in order.
+        return firstOther_ + (r - organs);
+    }
+    static std::uint32_t OrganCount(const FlatScene& flat) {
         std::uint32_t organs = 0;
         while (organs < flat.receivers.size() &&
                flat.receivers[organs].kind == ReceiverKind::kOrgan)
             ++organs;
-        return firstOther_ + (r - organs);
+        return organs;
     }
     ShadowView ShadowsOf(const FlatScene& flat) const;
     // The light that arrived on closed instance c of `level`, as the sources of its contents.
@@ -209,9 +212,10 @@ ShadowView InstancedSolve::ShadowsOf(const FlatScene& flat) const {
     if (shadows_ == nullptr) return {};
     ShadowView view{shadows_, std::vector<std::uint32_t>(flat.triangles.size()),
                     flat.origin - receivers_.origin};
+    const std::uint32_t organs = OrganCount(flat);
     for (std::uint32_t r = 0; r < flat.receivers.size(); ++r) {
         const Receiver& local = flat.receivers[r];
-        const Receiver& whole = receivers_.receivers[Global(flat, r)];
+        const Receiver& whole = receivers_.receivers[Global(flat, organs, r)];
         LEAFLUX_CHECK_EQ(local.triangleCount, whole.triangleCount);
         for (std::uint32_t t = 0; t < local.triangleCount; ++t)
             view.triangleOf[local.firstTriangle + t] = whole.firstTriangle + t;
@@ -231,8 +235,9 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
                                      level.closed, std::move(problem));
     // Its receivers' light, where the scene has them.
     const FlatScene& flat = level.flat;
+    const std::uint32_t organs = OrganCount(flat);
     for (std::uint32_t r = 0; r < flat.receivers.size(); ++r)
-        out_.solution.light[Global(flat, r)] = std::move(light.solution.light[r]);
+        out_.solution.light[Global(flat, organs, r)] = std::move(light.solution.light[r]);
     InstancedStats::Problem size;
     size.depth = tree_[p].depth;
     size.triangles = static_cast<std::int64_t>(flat.triangles.size());
