@@ -98,6 +98,28 @@ TEST(PhaseFunction, CoarserKindsKeepTheScatteredPower) {
     EXPECT_EQ(mono.Bytes(), 34 * 2 * sizeof(float));
 }
 
+TEST(PhaseFunction, ItsTableHoldsItsValueAtEveryPair) {
+    PhaseFunction bi(PhaseKind::kBiDirectional, 2, 2);
+    Random random(11);
+    for (float& v : bi.MutableValues()) v = static_cast<float>(random.Uniform());
+    std::vector<glm::dvec3> in(7), out(5);
+    for (glm::dvec3& d : in) d = UniformSphere(random.Uniform(), random.Uniform());
+    for (glm::dvec3& d : out) d = UniformSphere(random.Uniform(), random.Uniform());
+    for (PhaseKind kind :
+         {PhaseKind::kBiDirectional, PhaseKind::kMonoDirectional, PhaseKind::kConstant}) {
+        const PhaseFunction f = bi.Reduced(kind);
+        for (int band = 0; band < 2; ++band) {
+            std::vector<double> table(in.size() * out.size());
+            f.Table(band, in, out, table.data());
+            for (std::size_t o = 0; o < out.size(); ++o) {
+                for (std::size_t i = 0; i < in.size(); ++i)
+                    EXPECT_NEAR(table[o * in.size() + i], f.Value(band, in[i], out[o]), 1e-12)
+                        << PhaseKindName(kind) << " band " << band;
+            }
+        }
+    }
+}
+
 TEST(PhaseFunction, StoredValuesOfTheWrongCountAreRefused) {
     EXPECT_THROW(PhaseFunction::FromValues(PhaseKind::kBiDirectional, 1, 1, std::vector<float>(99)),
                  std::invalid_argument);

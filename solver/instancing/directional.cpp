@@ -123,6 +123,39 @@ double PhaseFunction::Value(int band, const glm::dvec3& towardSource,
     return value;
 }
 
+void PhaseFunction::Table(int band, std::span<const glm::dvec3> towardSources,
+                          std::span<const glm::dvec3> outgoing, double* table) const {
+    const std::size_t inputs = towardSources.size();
+    if (kind_ != PhaseKind::kBiDirectional) {  // alike towards every outgoing direction
+        for (std::size_t i = 0; i < inputs; ++i) {
+            const double value = Value(band, towardSources[i], towardSources[i]);
+            for (std::size_t o = 0; o < outgoing.size(); ++o) table[o * inputs + i] = value;
+        }
+        return;
+    }
+    const DirectionSet& set = Directions();
+    const std::size_t n = set.Size();
+    // Per incoming direction, f interpolated there towards each of the set's directions.
+    std::vector<double> rows(inputs * n, 0.0);
+    for (std::size_t i = 0; i < inputs; ++i) {
+        const DirectionSet::Interpolation in = set.Locate(towardSources[i]);
+        double* row = rows.data() + i * n;
+        for (int k = 0; k < 3; ++k) {
+            for (std::size_t o = 0; o < n; ++o)
+                row[o] += in.weight[k] * V((in.vertex[k] * n + o) * bands_ + band);
+        }
+    }
+    for (std::size_t o = 0; o < outgoing.size(); ++o) {
+        const DirectionSet::Interpolation out = set.Locate(outgoing[o]);
+        for (std::size_t i = 0; i < inputs; ++i) {
+            const double* row = rows.data() + i * n;
+            double value = 0.0;
+            for (int j = 0; j < 3; ++j) value += out.weight[j] * row[out.vertex[j]];
+            table[o * inputs + i] = value;
+        }
+    }
+}
+
 double PhaseFunction::ScatteredPower(int band, const glm::dvec3& towardSource) const {
     if (kind_ != PhaseKind::kBiDirectional)
         return kFourPi * Value(band, towardSource, towardSource);

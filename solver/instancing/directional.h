@@ -82,6 +82,10 @@ class PhaseFunction {
     std::size_t Bytes() const { return values_.size() * sizeof(float); }
 
     double Value(int band, const glm::dvec3& towardSource, const glm::dvec3& outgoing) const;
+    // Value for every pair, each direction located once: table[o * towardSources.size() + i]
+    // = Value(band, towardSources[i], outgoing[o]).
+    void Table(int band, std::span<const glm::dvec3> towardSources,
+               std::span<const glm::dvec3> outgoing, double* table) const;
     // ∫ f(ωi, ωo) dωo (W per W/m²) from unit ωi.
     double ScatteredPower(int band, const glm::dvec3& towardSource) const;
 

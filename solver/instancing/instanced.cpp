@@ -25,28 +25,6 @@
 namespace leaflux {
 namespace {
 
-// A member of a signature group as its original makes it: the original's transmittance, and
-// its phase function scaled by the member's organ area over the representative's, for a
-// structure intercepts and scatters in proportion to its area.
-class MemberContents : public ClosedContents {
-  public:
-    MemberContents(std::shared_ptr<const Original> original, double areaM2)
-        : original_(std::move(original)),
-          scale_(original_->provenance.leafAreaM2 > 0.0 ? areaM2 / original_->provenance.leafAreaM2
-                                                        : 1.0) {}
-    double Transmittance(const glm::dvec3& omega) const override {
-        return original_->transmittance.Value(omega, 0);
-    }
-    double Phase(int band, const glm::dvec3& towardSource,
-                 const glm::dvec3& outgoing) const override {
-        return scale_ * original_->phase.Value(band, towardSource, outgoing);
-    }
-
-  private:
-    std::shared_ptr<const Original> original_;
-    double scale_;
-};
-
 // One part of the scene as a scene of its own, in the world frame, with its instances
 // closed; it lives while the parts under it are solved (their rays meet it).
 struct Level {
@@ -190,8 +168,12 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
         closed.boxMin = instance.boxMin;
         closed.boxMax = instance.boxMax;
         closed.areaM2 = instance.leafAreaM2;
-        closed.contents = std::make_shared<MemberContents>(
-            originals_.bySignature.at(instance.signature), instance.leafAreaM2);
+        const std::shared_ptr<const Original>& original =
+            originals_.bySignature.at(instance.signature);
+        closed.contents = std::make_shared<OriginalContents>(
+            original, original->provenance.leafAreaM2 > 0.0
+                          ? instance.leafAreaM2 / original->provenance.leafAreaM2
+                          : 1.0);
         level->closed.push_back(std::move(closed));
         level->closedPart.push_back(q);
     }

@@ -33,22 +33,31 @@ struct Original {
     OriginalProvenance provenance;
 };
 
-// An original as the radiosity engine's closed nodes see it (closed_node.h).
+// An original as the radiosity engine's closed nodes see it (closed_node.h). A member of a
+// signature group takes its group's original with its phase function scaled by its organ
+// area over the representative's (`phaseScale`), for a structure intercepts and scatters in
+// proportion to its area.
 class OriginalContents : public ClosedContents {
   public:
-    explicit OriginalContents(std::shared_ptr<const Original> original)
-        : original_(std::move(original)) {}
+    explicit OriginalContents(std::shared_ptr<const Original> original, double phaseScale = 1.0)
+        : original_(std::move(original)), scale_(phaseScale) {}
     double Transmittance(const glm::dvec3& omega) const override {
         return original_->transmittance.Value(omega, 0);
     }
     double Phase(int band, const glm::dvec3& towardSource,
                  const glm::dvec3& outgoing) const override {
-        return original_->phase.Value(band, towardSource, outgoing);
+        return scale_ * original_->phase.Value(band, towardSource, outgoing);
+    }
+    void PhaseTable(int band, std::span<const glm::dvec3> towardSources,
+                    std::span<const glm::dvec3> outgoing, double* table) const override {
+        original_->phase.Table(band, towardSources, outgoing, table);
+        for (std::size_t i = 0; i < towardSources.size() * outgoing.size(); ++i) table[i] *= scale_;
     }
     const Original& Of() const { return *original_; }
 
   private:
     std::shared_ptr<const Original> original_;
+    double scale_;
 };
 
 }  // namespace leaflux

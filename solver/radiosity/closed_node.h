@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "solver/raytrace/occlusion.h"
@@ -28,6 +29,15 @@ class ClosedContents {
     // inside it.
     virtual double Phase(int band, const glm::dvec3& towardSource,
                          const glm::dvec3& outgoing) const = 0;
+    // f for every pair: table[o * towardSources.size() + i] = Phase(band, towardSources[i],
+    // outgoing[o]).
+    virtual void PhaseTable(int band, std::span<const glm::dvec3> towardSources,
+                            std::span<const glm::dvec3> outgoing, double* table) const {
+        for (std::size_t o = 0; o < outgoing.size(); ++o) {
+            for (std::size_t i = 0; i < towardSources.size(); ++i)
+                table[o * towardSources.size() + i] = Phase(band, towardSources[i], outgoing[o]);
+        }
+    }
 };
 
 struct ClosedNode {

@@ -25,11 +25,8 @@ ClosedResponse::ClosedResponse(const NodeModel& model,
         for (std::size_t s = 0; s < sources.size(); ++s)
             in[bins_ + s] = closed.ToInstance(sources[s].toward);
         for (std::size_t b = 0; b < bands_; ++b) {
-            for (std::size_t o = 0; o < bins_; ++o) {
-                double* row = values_.data() + ((c * bands_ + b) * bins_ + o) * inputs_;
-                for (std::size_t i = 0; i < inputs_; ++i)
-                    row[i] = closed.contents->Phase(static_cast<int>(b), in[i], out[o]);
-            }
+            closed.contents->PhaseTable(static_cast<int>(b), in, out,
+                                        values_.data() + (c * bands_ + b) * bins_ * inputs_);
         }
     });
 }

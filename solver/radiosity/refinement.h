@@ -114,7 +114,7 @@ class Refiner {
         return false;
     }
     // Which of r and s a link between them splits: the larger, or the other when the
-    // larger cannot be split; none when neither can.
+    // larger cannot be split but is not a closed instance; none when neither can.
     Verdict::Kind SplitChoice(std::uint32_t r, std::uint32_t s) const;
     // Splits node n, subdividing a patch if it must (CanSplit(n) holds).
     void SplitNode(std::uint32_t n);

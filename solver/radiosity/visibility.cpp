@@ -118,28 +118,24 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
     rays += static_cast<std::int64_t>(starts.size());
     double visible = 0.0, total = 0.0;
     if (const ShadowView& shadows = occlusion_.Shadows(); light.beyond && shadows.rays) {
-        // From triangles, through the whole scene's (traced together); from a closed
-        // instance's points, through the levels' triangles and closed instances.
-        thread_local std::vector<RayStart> whole;
-        thread_local std::vector<glm::dvec3> wholeDirections;
-        thread_local std::vector<double> wholeWeights;
-        whole.clear(), wholeDirections.clear(), wholeWeights.clear();
+        // Through the whole scene's triangles, traced together: from a triangle's points, and
+        // from a closed instance's where they leave its box (what its own contents take of
+        // the light is in its phase function).
         for (std::size_t i = 0; i < starts.size(); ++i) {
             total += weights[i];
             if (closed[i] >= 0) {
-                const std::int32_t ends[2] = {closed[i], -1};
-                visible += weights[i] * occlusion_.Transmittance(starts[i], directions[i], INFINITY,
-                                                                 Exclusion(ends));
-                continue;
+                const double exit =
+                    occlusion_.ChordOf(closed[i], starts[i].origin, directions[i]).exit;
+                starts[i] = {starts[i].origin + std::max(exit, 0.0) * directions[i] +
+                             shadows.offset};
+            } else {
+                starts[i] = {starts[i].origin + shadows.offset,
+                             shadows.triangleOf[starts[i].triangle]};
             }
-            whole.push_back(
-                {starts[i].origin + shadows.offset, shadows.triangleOf[starts[i].triangle]});
-            wholeDirections.push_back(directions[i]);
-            wholeWeights.push_back(weights[i]);
         }
-        shadows.rays->Occluded(whole, wholeDirections, occluded);
-        for (std::size_t i = 0; i < whole.size(); ++i) {
-            if (!occluded[i]) visible += wholeWeights[i];
+        shadows.rays->Occluded(starts, directions, occluded);
+        for (std::size_t i = 0; i < starts.size(); ++i) {
+            if (!occluded[i]) visible += weights[i];
         }
         return total > 0.0 ? visible / total : 0.0;
     }

@@ -22,32 +22,43 @@ struct ProxyQuery {
     bool Cross(std::uint32_t id) {
         if (std::find(exclude.begin(), exclude.end(), id) != exclude.end()) return true;
         if (std::find(counted->begin(), counted->end(), id) != counted->end()) return true;
-        const Occlusion::Box& box = occlusion->boxes_[id];
-        const glm::dvec3 o = glm::dvec3(box.instanceFromScene * glm::dvec4(origin, 1.0));
-        const glm::dvec3 d = glm::dmat3(box.instanceFromScene) * direction;
-        double enter = -std::numeric_limits<double>::infinity();
-        double exit = std::numeric_limits<double>::infinity();
-        for (int axis = 0; axis < 3; ++axis) {
-            if (d[axis] == 0.0) {
-                if (o[axis] < box.boxMin[axis] || o[axis] > box.boxMax[axis]) return true;
-                continue;
-            }
-            double t0 = (box.boxMin[axis] - o[axis]) / d[axis];
-            double t1 = (box.boxMax[axis] - o[axis]) / d[axis];
-            if (t0 > t1) std::swap(t0, t1);
-            enter = std::max(enter, t0);
-            exit = std::min(exit, t1);
-        }
+        const Occlusion::Chord chord = occlusion->ChordOf(id, origin, direction);
+        const double enter = chord.enter, exit = chord.exit;
         const double from = std::max(enter, 0.0), to = std::min(exit, tFar);
         if (!(to > from) || !(exit > enter)) return true;
         counted->push_back(id);
         const double tau =
-            std::clamp(occlusion->proxies_[id].transmittance(glm::normalize(d)), 0.0, 1.0);
+            std::clamp(occlusion->proxies_[id].transmittance(chord.direction), 0.0, 1.0);
         const double fraction = std::min((to - from) / (exit - enter), 1.0);
         transmittance *= fraction >= 1.0 ? tau : std::pow(tau, fraction);
         return transmittance > 0.0;
     }
 };
+
+Occlusion::Chord Occlusion::ChordOf(std::uint32_t c, const glm::dvec3& origin,
+                                    const glm::dvec3& direction) const {
+    const Box& box = boxes_[c];
+    const glm::dvec3 o = glm::dvec3(box.instanceFromScene * glm::dvec4(origin, 1.0));
+    const glm::dvec3 d = glm::dmat3(box.instanceFromScene) * direction;
+    Chord chord{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                glm::normalize(d)};
+    double enter = -std::numeric_limits<double>::infinity();
+    double exit = std::numeric_limits<double>::infinity();
+    for (int axis = 0; axis < 3; ++axis) {
+        if (d[axis] == 0.0) {
+            if (o[axis] < box.boxMin[axis] || o[axis] > box.boxMax[axis]) return chord;
+            continue;
+        }
+        double t0 = (box.boxMin[axis] - o[axis]) / d[axis];
+        double t1 = (box.boxMax[axis] - o[axis]) / d[axis];
+        if (t0 > t1) std::swap(t0, t1);
+        enter = std::max(enter, t0);
+        exit = std::min(exit, t1);
+    }
+    chord.enter = enter;
+    chord.exit = exit;
+    return chord;
+}
 
 void Occlusion::Bounds(const RTCBoundsFunctionArguments* args) {
     const auto* self = static_cast<const Occlusion*>(args->geometryUserPtr);

@@ -99,6 +99,15 @@ class Occlusion {
         return boxes_.empty() ? 1.0 : ThroughBoxes(start, direction, maxDistance, exclude);
     }
 
+    // Where the line from `origin` along `direction` (unit) is inside closed instance c's
+    // box: from enter to exit, distances along the direction (exit < enter: it misses), and
+    // the direction in the instance's frame.
+    struct Chord {
+        double enter, exit;
+        glm::dvec3 direction;
+    };
+    Chord ChordOf(std::uint32_t c, const glm::dvec3& origin, const glm::dvec3& direction) const;
+
     std::size_t ProxyCount() const { return proxies_.size(); }
     const ShadowView& Shadows() const { return shadows_; }
     // Triangles alone, nothing outside: a ray passes or not (traced in batches).
