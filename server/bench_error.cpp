@@ -210,6 +210,17 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
             tau.setting += " shadows=tau";
             tau.settings.instanced.shadowsByGeometry = false;
             runs.push_back(tau);
+            // Stopping early, compared per structure solved whole (absorbed power).
+            Run branches = run;
+            branches.setting += " output=axis";
+            branches.settings.instanced.outputLevel = NodeType::kAxis;
+            runs.push_back(branches);
+            for (int depth : options.instancedDepths) {
+                Run shallow = run;
+                shallow.setting += " depth=" + std::to_string(depth);
+                shallow.settings.instanced.maxDepth = depth;
+                runs.push_back(shallow);
+            }
         }
     }
     if (options.directOnly) {
@@ -273,7 +284,9 @@ void PrintTable(const std::string& scene, const std::vector<Row>& rows) {
 
 std::vector<Row> RowsOf(const Run& run, const Scene& scene, const FlatScene& flat,
                         const Solution& reference, const Solution& solution) {
-    const std::vector<BandAccuracy> accuracy = CompareLeaves(scene, flat, reference, solution);
+    const std::vector<BandAccuracy> accuracy =
+        solution.wholeStructures.empty() ? CompareLeaves(scene, flat, reference, solution)
+                                         : CompareWholeStructures(scene, flat, reference, solution);
     std::vector<Row> rows;
     for (std::size_t b = 0; b < scene.bands.size(); ++b) {
         rows.push_back({run.solver, run.setting, scene.bands[b].name, solution.stats, accuracy[b],

@@ -37,6 +37,21 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
     solve.add_flag("--single-value", command.singleValue,
                    "instanced: a closed instance sends its power alike in every direction (the "
                    "paper's single value) instead of by direction");
+    auto* depth = solve
+                      .add_option("--max-depth", command.maxDepth,
+                                  "instanced: open instances down to this depth only (1: the "
+                                  "largest); deeper ones are solved whole, each as one structure "
+                                  "(--structures), their leaves left out of --out; 0: every depth")
+                      ->capture_default_str()
+                      ->check(CLI::Range(0, 64));
+    solve
+        .add_option("--output-level", command.outputLevel,
+                    "instanced: light per structure of this type: an instance is opened only "
+                    "while it holds instances of the type, the others are solved whole "
+                    "(--structures) and their leaves never built; e.g. axis for light per "
+                    "branch")
+        ->check(CLI::IsMember({"plant", "axis", "phytomer"}))
+        ->excludes(depth);
     solve.add_option("--problems", command.problems,
                      "instanced: CSV of every local problem solved: depth, triangles, closed "
                      "instances, elements, links, seconds");
@@ -54,12 +69,21 @@ Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene*
     InstancedOptions options;
     options.hrc = hrc;
     options.hrc.directionalInstances = !command.singleValue;
+    options.maxDepth = command.maxDepth;
+    if (!command.outputLevel.empty()) {
+        options.outputLevel = command.outputLevel == "plant"  ? NodeType::kPlant
+                              : command.outputLevel == "axis" ? NodeType::kAxis
+                                                              : NodeType::kPhytomer;
+    }
     const InstancedSolution solved =
         SolveInstanced(scene, flat, shadows, policy, database, options);
     const InstancedStats& stats = solved.stats;
     std::printf("instances by depth (opened):");
     for (std::size_t d = 1; d < stats.depths.size(); ++d)
         std::printf(" %zu: %d (%d)", d, stats.depths[d].instances, stats.depths[d].opened);
+    int whole = 0;
+    for (const InstancedStats::Depth& d : stats.depths) whole += d.whole;
+    if (whole > 0) std::printf("; %d solved whole", whole);
     std::printf(
         "\nphase functions: %d computed in %.2f s, %d reused; solving %.2f s; peak %.1f MiB\n",
         stats.originalsComputed, stats.originalSeconds, stats.originalsReused, stats.solveSeconds,

@@ -17,6 +17,8 @@ struct InstancedCommand {
     std::string shadows = "geometry";
     bool singleValue = false;
     std::string problems;  // CSV of the local problems solved
+    int maxDepth = 0;
+    std::string outputLevel;  // "", "plant", "axis" or "phytomer"
 };
 
 // Adds the instanced solver's options to `solve`.

@@ -530,10 +530,17 @@ int main(int argc, char** argv) {
     errorApp
         ->add_option("--instanced-epsilon", errorBench.instancedEpsilons,
                      "Instanced runs: ε of each (none by default); the first also from an empty "
-                     "phase-function database, the middle one also with the single value and "
-                     "with shadows by transmittance")
+                     "phase-function database, the middle one also with the single value, "
+                     "with shadows by transmittance and with light per branch "
+                     "(--output-level axis)")
         ->delimiter(',')
         ->check(CLI::Range(1e-9, 1.0));
+    errorApp
+        ->add_option("--instanced-depth", errorBench.instancedDepths,
+                     "Instanced runs at the middle ε opened down to each of these depths only "
+                     "(--max-depth), compared per structure solved whole")
+        ->delimiter(',')
+        ->check(CLI::Range(1, 64));
     errorApp->add_option("--policy", benchPolicy,
                          "Instanced runs: instantiation policy file (default: the built-in one)");
     errorApp->add_flag("!--no-direct", errorBench.directOnly,

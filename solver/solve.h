@@ -2,6 +2,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "solver/instancing/instanced.h"
@@ -21,6 +22,8 @@ struct InstancedSettings {
     PhaseDatabase* database = nullptr;  // null: one in memory for this solve
     OriginalSettings originals;
     bool shadowsByGeometry = true;
+    int maxDepth = 0;                     // InstancedOptions::maxDepth
+    std::optional<NodeType> outputLevel;  // InstancedOptions::outputLevel
     // Filled by the solve when not null: its instances, local problems and originals.
     InstancedStats* stats = nullptr;
 };

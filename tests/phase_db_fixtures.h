@@ -40,6 +40,10 @@ inline Original SyntheticOriginal(PhaseKind kind, int level, int bands, unsigned
     }
     original.phase = PhaseFunction(kind, level, bands);
     fill(original.phase.MutableValues());
+    original.absorption = SphereFunction(level, bands);
+    for (int d = 0; d < original.absorption.Directions().Size(); ++d) {
+        for (int b = 0; b < bands; ++b) original.absorption.At(d, b) = uniform(random);
+    }
     original.provenance.representative = "plant " + std::to_string(seed) + " / axis 1";
     original.provenance.leafCount = 10 + seed;
     original.provenance.leafAreaM2 = 0.01 * seed;

@@ -56,6 +56,9 @@ bool SameValues(const Original& a, const Original& b) {
            same(a.phase.Values(), b.phase.Values()) &&
            a.transmittance.Level() == b.transmittance.Level() &&
            same(a.transmittance.Values(), b.transmittance.Values()) &&
+           a.absorption.Level() == b.absorption.Level() &&
+           a.absorption.Channels() == b.absorption.Channels() &&
+           same(a.absorption.Values(), b.absorption.Values()) &&
            a.provenance.representative == b.provenance.representative &&
            a.provenance.leafCount == b.provenance.leafCount &&
            a.provenance.accuracy == b.provenance.accuracy &&
@@ -125,6 +128,21 @@ TEST(PhaseDbCodec, RoundTripIsBitIdentical) {
         const std::vector<std::uint8_t> blob = EncodeOriginal(original);
         EXPECT_TRUE(SameValues(DecodeOriginal(blob, "blob"), original)) << PhaseKindName(kind);
     }
+}
+
+// Originals stored before the absorption was (format 1) are read, without it.
+TEST(PhaseDbCodec, AFormatOneBlobIsReadWithoutItsAbsorption) {
+    Original original = SyntheticOriginal(PhaseKind::kMonoDirectional, 2, 2, 1);
+    original.absorption = SphereFunction();
+    std::vector<std::uint8_t> blob = EncodeOriginal(original);
+    // Format 1: no absorption's level, channels and (empty) values after f's values.
+    const std::size_t tau = 4 + 1 + 48 + 4 + 4 + 4 + original.transmittance.Values().size_bytes();
+    const std::size_t absorption = tau + 1 + 4 + 4 + 4 + original.phase.Bytes();
+    blob.erase(blob.begin() + absorption, blob.begin() + absorption + 12);
+    blob[4] = 1;
+    const Original decoded = DecodeOriginal(blob, "row 1");
+    EXPECT_TRUE(decoded.absorption.Empty());
+    EXPECT_TRUE(SameValues(decoded, original));
 }
 
 TEST(PhaseDbCodec, DamagedBlobsAreParseErrors) {

@@ -31,6 +31,7 @@ Original ComputeOriginal(const StructureAlone& structure, const OriginalSettings
             transmittance.At(i, 0) = static_cast<float>(mean);
     }
     PhaseFunction f;
+    SphereFunction absorption;
     double phaseError = 0.0;
     if (settings.method == PhaseMethod::kPhotons) {
         PhotonOptions photons;
@@ -40,6 +41,12 @@ Original ComputeOriginal(const StructureAlone& structure, const OriginalSettings
         photons.seed = settings.seed;
         PhaseEstimate phase = PhaseFromPhotons(structure, photons);
         f = std::move(phase.phase);
+        absorption = SphereFunction(photons.level, f.Bands());
+        for (std::size_t i = 0; i < phase.beams.size(); ++i) {
+            for (int b = 0; b < f.Bands(); ++b)
+                absorption.At(static_cast<int>(i), b) =
+                    static_cast<float>(phase.beams[i].absorbedW[b]);
+        }
         // The RMS over the beams of the scattered power's relative standard error.
         int lit = 0;
         for (const BeamBalance& beam : phase.beams) {
@@ -55,7 +62,13 @@ Original ComputeOriginal(const StructureAlone& structure, const OriginalSettings
         radiosity.level = settings.kind == PhaseKind::kConstant ? 2 : settings.phaseLevel;
         radiosity.hrc.epsilon = settings.epsilon;
         radiosity.seed = settings.seed;
-        f = PhaseFromRadiosity(structure, radiosity).phase;
+        RadiosityPhase phase = PhaseFromRadiosity(structure, radiosity);
+        f = std::move(phase.phase);
+        absorption = SphereFunction(radiosity.level, f.Bands());
+        for (int i = 0; i < absorption.Directions().Size(); ++i) {
+            for (int b = 0; b < f.Bands(); ++b)
+                absorption.At(i, b) = static_cast<float>(phase.absorbedW[i * f.Bands() + b]);
+        }
     }
 
     Original original;
@@ -63,6 +76,7 @@ Original ComputeOriginal(const StructureAlone& structure, const OriginalSettings
     original.boxMax = structure.BoxMax() + structure.Origin();
     original.transmittance = std::move(transmittance);
     original.phase = std::move(f);
+    original.absorption = std::move(absorption);
     OriginalProvenance& p = original.provenance;
     p.representative = structure.Name();
     p.leafCount = structure.LeafCount();

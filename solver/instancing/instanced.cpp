@@ -63,6 +63,7 @@ class InstancedSolve {
         out_.solution.light.assign(receivers.receivers.size(),
                                    std::vector<BandLight>(scene.bands.size()));
         out_.solution.balance.assign(scene.bands.size(), EnergyBalance{});
+        out_.solution.unsolved.assign(receivers.receivers.size(), 0);
         out_.stats.depths.assign(tree.Depth() + 1, InstancedStats::Depth{});
         for (const InstanceTree::Part& part : tree.Parts())
             ++out_.stats.depths[part.depth].instances;
@@ -102,6 +103,13 @@ class InstancedSolve {
     // The light that arrived on closed instance c of `level`, as the sources of its contents.
     std::vector<DirectionalSource> ArrivedOn(const LevelSolution& light, std::size_t c) const;
     void OpenInstances(const Level& level, const LevelSolution& light);
+    // Whether part q is opened (InstancedOptions::maxDepth, outputLevel).
+    bool Opens(std::uint32_t q) const;
+    bool HoldsInstanceOf(std::uint32_t q, NodeType type) const;
+    // Closed instance c of `level` solved whole from the light that arrived on it.
+    void SolveWhole(const Level& level, const LevelSolution& light, std::size_t c);
+    // Marks the organs of part q and of the parts in it unsolved; their count and area.
+    void MarkUnsolved(std::uint32_t q, StructureLight& whole);
     void Open(const Level& parent, std::size_t c, std::vector<DirectionalSource> sources);
 
     const Scene& scene_;
@@ -286,11 +294,102 @@ std::vector<DirectionalSource> InstancedSolve::ArrivedOn(const LevelSolution& li
 }
 
 void InstancedSolve::OpenInstances(const Level& level, const LevelSolution& light) {
-    std::vector<std::vector<DirectionalSource>> arrived(level.closed.size());
-    for (std::size_t c = 0; c < level.closed.size(); ++c) arrived[c] = ArrivedOn(light, c);
+    std::vector<std::size_t> opened;
+    for (std::size_t c = 0; c < level.closed.size(); ++c) {
+        if (Opens(level.closedPart[c])) {
+            opened.push_back(c);
+        } else {
+            SolveWhole(level, light, c);
+        }
+    }
+    std::vector<std::vector<DirectionalSource>> arrived(opened.size());
+    for (std::size_t i = 0; i < opened.size(); ++i) arrived[i] = ArrivedOn(light, opened[i]);
     // Siblings are independent once their parent is solved: each its own problem.
-    tbb::parallel_for(std::size_t{0}, level.closed.size(),
-                      [&](std::size_t c) { Open(level, c, std::move(arrived[c])); });
+    tbb::parallel_for(std::size_t{0}, opened.size(),
+                      [&](std::size_t i) { Open(level, opened[i], std::move(arrived[i])); });
+}
+
+bool InstancedSolve::HoldsInstanceOf(std::uint32_t q, NodeType type) const {
+    for (std::uint32_t inner : tree_[q].instances) {
+        if (scene_.nodes[tree_[inner].rootIndex].type == type || HoldsInstanceOf(inner, type))
+            return true;
+    }
+    return false;
+}
+
+bool InstancedSolve::Opens(std::uint32_t q) const {
+    if (options_.maxDepth > 0 && tree_[q].depth > options_.maxDepth) return false;
+    return !options_.outputLevel || HoldsInstanceOf(q, *options_.outputLevel);
+}
+
+void InstancedSolve::MarkUnsolved(std::uint32_t q, StructureLight& whole) {
+    for (std::size_t i : tree_[q].nodes) {
+        const auto it = organReceiver_.find(scene_.nodes[i].id);
+        if (it == organReceiver_.end()) continue;
+        out_.solution.unsolved[it->second] = 1;
+        ++whole.organCount;
+        whole.areaM2 += receivers_.receivers[it->second].areaM2;
+    }
+    for (std::uint32_t inner : tree_[q].instances) MarkUnsolved(inner, whole);
+}
+
+void InstancedSolve::SolveWhole(const Level& level, const LevelSolution& light, std::size_t c) {
+    const std::uint32_t q = level.closedPart[c];
+    const InstanceTree::Part& part = tree_[q];
+    const Node& root = scene_.nodes[part.rootIndex];
+    const Original& original = *originals_.bySignature.at(part.signature);
+    const double scale = original.provenance.leafAreaM2 > 0.0
+                             ? part.leafAreaM2 / original.provenance.leafAreaM2
+                             : 1.0;
+    const glm::dvec3 extent = original.boxMax - original.boxMin;
+    const ClosedNode& closed = level.closed[c];
+    const int channels = static_cast<int>(scene_.bands.size());
+    StructureLight whole;
+    whole.node = root.id;
+    whole.name = scene_.NodeName(root);
+    whole.type = root.type;
+    whole.bands.assign(channels, BandLight{});
+    for (BandLight& band : whole.bands)
+        band.irradianceUpperWm2 = band.irradianceLowerWm2 = std::nan("");
+    // Irradiance e (W/m² normal to ω) arriving from unit ω (world, towards the source); from
+    // a sun or sky cone, light incident on the scene, counted in the balance.
+    std::vector<double> incident(channels, 0.0);
+    const auto arrive = [&](const glm::dvec3& omega, const double* e, bool fromSource) {
+        const glm::dvec3 in = closed.ToInstance(omega);
+        const glm::dvec3 a = glm::abs(in);
+        const double section =
+            a.x * extent.y * extent.z + a.y * extent.x * extent.z + a.z * extent.x * extent.y;
+        const double intercepted = section * (1.0 - original.transmittance.Value(in, 0));
+        for (int k = 0; k < channels; ++k) {
+            BandLight& band = whole.bands[k];
+            // Format-1 originals have no absorption: what f does not scatter of it.
+            band.absorbedW +=
+                scale * e[k] *
+                (original.absorption.Empty()
+                     ? std::max(0.0, intercepted - original.phase.ScatteredPower(k, in))
+                     : original.absorption.Value(in, k));
+            band.radianceIntegral += e[k];
+            band.radianceMoment += e[k] * omega;
+            if (fromSource) incident[k] += scale * e[k] * intercepted;
+        }
+    };
+    std::vector<double> e(channels);
+    for (std::size_t s = 0; s < light.sources.size(); ++s) {
+        const double visibility = light.sourceVisibility[c][s];
+        if (visibility <= 0.0) continue;
+        for (int k = 0; k < channels; ++k) e[k] = visibility * light.sources[s].normalIrradiance[k];
+        arrive(light.sources[s].toward, e.data(), light.sources[s].beyond);
+    }
+    for (int d = 0; d < light.bins; ++d)
+        arrive(directions_.Direction(d), light.arrivedBins[c].data() + d * channels, false);
+    std::lock_guard lock(statsMutex_);
+    for (int k = 0; k < channels; ++k) {
+        out_.solution.balance[k].absorbedW += whole.bands[k].absorbedW;
+        out_.solution.balance[k].incidentW += incident[k];
+    }
+    MarkUnsolved(q, whole);
+    ++out_.stats.depths[part.depth].whole;
+    out_.solution.wholeStructures.push_back(std::move(whole));
 }
 
 void InstancedSolve::Open(const Level& parent, std::size_t c,
@@ -321,7 +420,11 @@ InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& receivers,
     solve.Run();
     out.stats.solveSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    // The problems by depth and size, whatever order the threads solved them in.
+    // The structures solved whole by node, and the problems by depth and size, whatever
+    // order the threads solved them in.
+    std::sort(out.solution.wholeStructures.begin(), out.solution.wholeStructures.end(),
+              [](const StructureLight& a, const StructureLight& b) { return a.node < b.node; });
+    if (out.solution.wholeStructures.empty()) out.solution.unsolved.clear();
     std::sort(out.stats.problems.begin(), out.stats.problems.end(),
               [](const InstancedStats::Problem& a, const InstancedStats::Problem& b) {
                   return std::tie(a.depth, a.triangles, a.elements, a.links) <

@@ -28,6 +28,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "solver/instancing/compute_original.h"
@@ -43,12 +44,23 @@ struct InstancedOptions {
     // How an original missing from the database is computed; the policy sets the kinds
     // and direction sets of its functions (SettingsOf).
     OriginalSettings originals;
+    // Where opening stops (Soler 2003 §7.1): an instance deeper than maxDepth (1: the
+    // largest; 0: no limit) stays closed, and so does one holding no instance of type
+    // outputLevel when it is set (kAxis: light per branch; the smallest branches' leaves
+    // are never built into a hierarchy). A structure left closed is solved whole from the
+    // light that arrived on it and its original (Solution::wholeStructures): its absorbed
+    // power is that light times the original's absorption per direction (scaled by organ
+    // area as f is); its light vector is that of the light arriving on its box; its
+    // leaves' irradiances are not solved.
+    int maxDepth = 0;
+    std::optional<NodeType> outputLevel;
 };
 
 struct InstancedStats {
     struct Depth {
         int instances = 0;  // structures instantiated at this depth (1: the largest)
         int opened = 0;
+        int whole = 0;  // left closed and solved whole (maxDepth, outputLevel)
     };
     std::vector<Depth> depths;  // [0] is the top
     // Every part solved, the top first: the local problems' sizes (Fig. 14, right).

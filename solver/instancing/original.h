@@ -30,6 +30,10 @@ struct Original {
     glm::dvec3 boxMin{0.0}, boxMax{0.0};  // the structure's bounds in its frame (m)
     SphereFunction transmittance;         // τ(ω), one channel
     PhaseFunction phase;
+    // The power the structure absorbs (W) per unit irradiance (W/m², normal to the beam)
+    // arriving from ω, per band: what a structure solved whole absorbs (instanced.h).
+    // Empty in an original of format 1.
+    SphereFunction absorption;
     OriginalProvenance provenance;
 };
 

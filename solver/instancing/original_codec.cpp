@@ -104,6 +104,10 @@ std::vector<std::uint8_t> EncodeOriginal(const Original& original) {
     out.Put(static_cast<std::int32_t>(phase.Level()));
     out.Put(static_cast<std::int32_t>(phase.Bands()));
     out.PutFloats(phase.Values());
+    const SphereFunction& absorption = original.absorption;
+    out.Put(static_cast<std::int32_t>(absorption.Level()));
+    out.Put(static_cast<std::int32_t>(absorption.Channels()));
+    out.PutFloats(absorption.Values());
     const OriginalProvenance& p = original.provenance;
     out.PutString(p.representative);
     out.Put(p.leafCount);
@@ -121,8 +125,11 @@ Original DecodeOriginal(std::span<const std::uint8_t> blob, const std::string& w
     for (const char c : kMagic) {
         if (in.Get<char>("magic") != c) in.Fail("magic", "not an original (no \"LFOR\")");
     }
-    if (const auto version = in.Get<std::uint8_t>("format"); version != kOriginalFormatVersion)
-        in.Fail("format", "format version " + std::to_string(version) + ", this leaflux reads " +
+    // Format 1 had no absorption: read still, the absorption empty.
+    const auto version = in.Get<std::uint8_t>("format");
+    if (version != 1 && version != kOriginalFormatVersion)
+        in.Fail("format", "format version " + std::to_string(version) +
+                              ", this leaflux reads 1 to " +
                               std::to_string(kOriginalFormatVersion));
     Original original;
     for (int axis = 0; axis < 3; ++axis) original.boxMin[axis] = in.Get<double>("box_min");
@@ -144,6 +151,14 @@ Original DecodeOriginal(std::span<const std::uint8_t> blob, const std::string& w
         if (!(values.empty() && bands == 0))
             original.phase = PhaseFunction::FromValues(static_cast<PhaseKind>(kind), level, bands,
                                                        std::move(values));
+        if (version >= 2) {
+            const auto absorptionLevel = in.Get<std::int32_t>("absorption.level");
+            const auto absorptionChannels = in.Get<std::int32_t>("absorption.channels");
+            std::vector<float> absorption = in.GetFloats("absorption.values");
+            if (!(absorption.empty() && absorptionChannels == 0))
+                original.absorption = SphereFunction::FromValues(
+                    absorptionLevel, absorptionChannels, std::move(absorption));
+        }
     } catch (const std::invalid_argument& e) {
         in.Fail("functions", e.what());
     }
@@ -163,8 +178,8 @@ Original DecodeOriginal(std::span<const std::uint8_t> blob, const std::string& w
 
 std::size_t OriginalBytes(const Original& original) {
     return sizeof(Original) + original.transmittance.Values().size_bytes() +
-           original.phase.Bytes() + original.provenance.representative.capacity() +
-           original.provenance.method.capacity();
+           original.phase.Bytes() + original.absorption.Values().size_bytes() +
+           original.provenance.representative.capacity() + original.provenance.method.capacity();
 }
 
 }  // namespace leaflux

@@ -16,7 +16,7 @@
 
 namespace leaflux {
 
-inline constexpr std::uint8_t kOriginalFormatVersion = 1;
+inline constexpr std::uint8_t kOriginalFormatVersion = 2;  // 2: with the absorption
 
 std::vector<std::uint8_t> EncodeOriginal(const Original& original);
 // Throws InputError(kParse, `what`) when the bytes are not an original of a known format

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "solver/util/check.h"
@@ -28,6 +29,42 @@ double BothSides(const BandLight& light) {
     return light.irradianceUpperWm2 + light.irradianceLowerWm2;
 }
 
+// A value against the reference's, and the reference's standard error (negative: none).
+struct Pair {
+    double expected, value, standardError;
+};
+
+BandAccuracy Accuracy(const std::vector<Pair>& pairs) {
+    BandAccuracy accuracy;
+    accuracy.leaves = static_cast<int>(pairs.size());
+    for (const Pair& p : pairs)
+        accuracy.referenceMaxWm2 = std::max(accuracy.referenceMaxWm2, p.expected);
+    if (accuracy.referenceMaxWm2 <= 0.0) return accuracy;
+    double squaredError = 0.0, squaredStderr = 0.0;
+    std::vector<double> relative;
+    for (const Pair& p : pairs) {
+        const double error = p.value - p.expected;
+        squaredError += error * error;
+        if (p.standardError >= 0.0) squaredStderr += p.standardError * p.standardError;
+        if (p.expected >= BandAccuracy::kLitFraction * accuracy.referenceMaxWm2)
+            relative.push_back(std::abs(error) / p.expected);
+    }
+    const double n = static_cast<double>(pairs.size());
+    accuracy.l2PctOfMax = 100.0 * std::sqrt(squaredError / n) / accuracy.referenceMaxWm2;
+    accuracy.referenceFloorPct = 100.0 * std::sqrt(squaredStderr / n) / accuracy.referenceMaxWm2;
+    accuracy.litLeaves = static_cast<int>(relative.size());
+    double sum = 0.0;
+    for (double e : relative) sum += e;
+    accuracy.meanRelativePct = 100.0 * sum / static_cast<double>(relative.size());
+    // The 95th percentile: the value 95 % of the lit leaves stay at or below.
+    const std::size_t rank =
+        std::min(relative.size() - 1, static_cast<std::size_t>(0.95 * relative.size()));
+    const auto p95 = relative.begin() + static_cast<std::ptrdiff_t>(rank);
+    std::nth_element(relative.begin(), p95, relative.end());
+    accuracy.p95RelativePct = 100.0 * *p95;
+    return accuracy;
+}
+
 }  // namespace
 
 std::vector<BandAccuracy> CompareLeaves(const Scene& scene, const FlatScene& flat,
@@ -35,44 +72,37 @@ std::vector<BandAccuracy> CompareLeaves(const Scene& scene, const FlatScene& fla
     LEAFLUX_CHECK_EQ(reference.light.size(), flat.receivers.size());
     LEAFLUX_CHECK_EQ(value.light.size(), flat.receivers.size());
     const std::vector<std::size_t> leaves = LeafReceivers(scene, flat);
-    std::vector<BandAccuracy> bands(scene.bands.size());
-    for (std::size_t b = 0; b < bands.size(); ++b) {
-        BandAccuracy& accuracy = bands[b];
-        accuracy.leaves = static_cast<int>(leaves.size());
-        for (std::size_t r : leaves) {
-            accuracy.referenceMaxWm2 =
-                std::max(accuracy.referenceMaxWm2, BothSides(reference.light[r][b]));
-        }
-        if (accuracy.referenceMaxWm2 <= 0.0) continue;
-        double squaredError = 0.0, squaredStderr = 0.0;
-        std::vector<double> relative;
+    std::vector<BandAccuracy> bands;
+    for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+        std::vector<Pair> pairs;
         for (std::size_t r : leaves) {
             const BandLight& truth = reference.light[r][b];
-            const double expected = BothSides(truth);
-            const double error = BothSides(value.light[r][b]) - expected;
-            squaredError += error * error;
-            if (truth.stderrUpperWm2 >= 0.0 && truth.stderrLowerWm2 >= 0.0) {
-                squaredStderr += truth.stderrUpperWm2 * truth.stderrUpperWm2 +
-                                 truth.stderrLowerWm2 * truth.stderrLowerWm2;
-            }
-            if (expected >= BandAccuracy::kLitFraction * accuracy.referenceMaxWm2) {
-                relative.push_back(std::abs(error) / expected);
-            }
+            const bool error = truth.stderrUpperWm2 >= 0.0 && truth.stderrLowerWm2 >= 0.0;
+            pairs.push_back(
+                {BothSides(truth), BothSides(value.light[r][b]),
+                 error ? std::hypot(truth.stderrUpperWm2, truth.stderrLowerWm2) : -1.0});
         }
-        const double n = static_cast<double>(leaves.size());
-        accuracy.l2PctOfMax = 100.0 * std::sqrt(squaredError / n) / accuracy.referenceMaxWm2;
-        accuracy.referenceFloorPct =
-            100.0 * std::sqrt(squaredStderr / n) / accuracy.referenceMaxWm2;
-        accuracy.litLeaves = static_cast<int>(relative.size());
-        double sum = 0.0;
-        for (double e : relative) sum += e;
-        accuracy.meanRelativePct = 100.0 * sum / static_cast<double>(relative.size());
-        // The 95th percentile: the value 95 % of the lit leaves stay at or below.
-        const std::size_t rank =
-            std::min(relative.size() - 1, static_cast<std::size_t>(0.95 * relative.size()));
-        const auto p95 = relative.begin() + static_cast<std::ptrdiff_t>(rank);
-        std::nth_element(relative.begin(), p95, relative.end());
-        accuracy.p95RelativePct = 100.0 * *p95;
+        bands.push_back(Accuracy(pairs));
+    }
+    return bands;
+}
+
+std::vector<BandAccuracy> CompareWholeStructures(const Scene& scene, const FlatScene& flat,
+                                                 const Solution& reference, const Solution& value) {
+    std::unordered_map<NodeId, const StructureLight*> truth;
+    const std::vector<StructureLight> structures = AggregateStructures(scene, flat, reference);
+    for (const StructureLight& s : structures) truth.emplace(s.node, &s);
+    std::vector<BandAccuracy> bands;
+    for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+        std::vector<Pair> pairs;
+        for (const StructureLight& whole : value.wholeStructures) {
+            const StructureLight& expected = *truth.at(whole.node);
+            const BandLight& light = expected.bands[b];
+            pairs.push_back(
+                {light.absorbedW / expected.areaM2, whole.bands[b].absorbedW / whole.areaM2,
+                 light.stderrAbsorbedW >= 0.0 ? light.stderrAbsorbedW / expected.areaM2 : -1.0});
+        }
+        bands.push_back(Accuracy(pairs));
     }
     return bands;
 }

@@ -31,5 +31,10 @@ struct BandAccuracy {
 // lit leaf (an empty or dark scene) gets zeros.
 std::vector<BandAccuracy> CompareLeaves(const Scene& scene, const FlatScene& flat,
                                         const Solution& reference, const Solution& value);
+// The same over the structures `value` solved whole (Solution::wholeStructures), on their
+// absorbed power per organ area (W/m²) against the reference's over the same organs;
+// `leaves` counts those structures.
+std::vector<BandAccuracy> CompareWholeStructures(const Scene& scene, const FlatScene& flat,
+                                                 const Solution& reference, const Solution& value);
 
 }  // namespace leaflux

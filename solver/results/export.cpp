@@ -1,5 +1,6 @@
 #include "solver/results/export.h"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -21,9 +22,11 @@ std::string Quoted(const std::string& text) {
 
 void WriteLight(std::ostream& out, const BandLight& light) {
     const glm::dvec3 v = light.LightVector();
-    out << Number(light.irradianceUpperWm2) << ',' << Number(light.irradianceLowerWm2) << ','
-        << Number(light.absorbedW) << ',' << Number(v.x) << ',' << Number(v.y) << ',' << Number(v.z)
-        << ',';
+    // NaN: not solved (a structure solved whole), an empty cell.
+    const auto irradiance = [](double value) { return std::isnan(value) ? "" : Number(value); };
+    out << irradiance(light.irradianceUpperWm2) << ',' << irradiance(light.irradianceLowerWm2)
+        << ',' << Number(light.absorbedW) << ',' << Number(v.x) << ',' << Number(v.y) << ','
+        << Number(v.z) << ',';
     if (light.stderrUpperWm2 >= 0.0) {
         out << Number(light.stderrUpperWm2) << ',' << Number(light.stderrLowerWm2);
     } else {
@@ -42,6 +45,7 @@ void WriteLeafCsv(std::ostream& out, const Scene& scene, const FlatScene& flat,
                   const Solution& solution) {
     out << "organ,band,area_m2," << kLightColumns;
     for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
+        if (!solution.unsolved.empty() && solution.unsolved[r]) continue;
         for (std::size_t b = 0; b < scene.bands.size(); ++b) {
             out << Quoted(flat.receivers[r].name) << ',' << Quoted(scene.bands[b].name) << ','
                 << Number(flat.receivers[r].areaM2) << ',';

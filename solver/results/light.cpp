@@ -31,36 +31,44 @@ std::vector<StructureLight> AggregateStructures(const Scene& scene, const FlatSc
 
     // Sums first: area-weighted irradiances and squared errors; normalised at the end.
     std::unordered_map<NodeId, StructureLight> sums;
+    // Adds `organs` organs of area a and light `light` (area means, summed powers) to s.
+    const auto add = [&](StructureLight& s, int organs, double a,
+                         const std::vector<BandLight>& light) {
+        if (s.bands.empty()) {
+            s.bands.assign(bands, BandLight{});
+            for (BandLight& b : s.bands)
+                b.stderrUpperWm2 = b.stderrLowerWm2 = b.stderrAbsorbedW = 0.0;
+        }
+        s.organCount += organs;
+        s.areaM2 += a;
+        for (std::size_t b = 0; b < bands; ++b) {
+            const BandLight& leaf = light[b];
+            BandLight& sum = s.bands[b];
+            sum.irradianceUpperWm2 += a * leaf.irradianceUpperWm2;
+            sum.irradianceLowerWm2 += a * leaf.irradianceLowerWm2;
+            sum.absorbedW += leaf.absorbedW;
+            sum.radianceIntegral += a * leaf.radianceIntegral;
+            sum.radianceMoment += a * leaf.radianceMoment;
+            const bool hasError = leaf.stderrUpperWm2 >= 0.0;
+            sum.stderrUpperWm2 =
+                hasError ? sum.stderrUpperWm2 + std::pow(a * leaf.stderrUpperWm2, 2) : -1.0;
+            sum.stderrLowerWm2 =
+                hasError ? sum.stderrLowerWm2 + std::pow(a * leaf.stderrLowerWm2, 2) : -1.0;
+            sum.stderrAbsorbedW =
+                hasError ? sum.stderrAbsorbedW + std::pow(leaf.stderrAbsorbedW, 2) : -1.0;
+        }
+    };
     for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
         const Receiver& receiver = flat.receivers[r];
         if (receiver.kind != ReceiverKind::kOrgan) continue;
-        for (NodeId at = receiver.node; at != kNoParent; at = byId.at(at)->parent) {
-            StructureLight& s = sums[at];
-            if (s.bands.empty()) {
-                s.bands.assign(bands, BandLight{});
-                for (BandLight& b : s.bands)
-                    b.stderrUpperWm2 = b.stderrLowerWm2 = b.stderrAbsorbedW = 0.0;
-            }
-            ++s.organCount;
-            s.areaM2 += receiver.areaM2;
-            for (std::size_t b = 0; b < bands; ++b) {
-                const BandLight& leaf = solution.light[r][b];
-                BandLight& sum = s.bands[b];
-                const double a = receiver.areaM2;
-                sum.irradianceUpperWm2 += a * leaf.irradianceUpperWm2;
-                sum.irradianceLowerWm2 += a * leaf.irradianceLowerWm2;
-                sum.absorbedW += leaf.absorbedW;
-                sum.radianceIntegral += a * leaf.radianceIntegral;
-                sum.radianceMoment += a * leaf.radianceMoment;
-                const bool hasError = leaf.stderrUpperWm2 >= 0.0;
-                sum.stderrUpperWm2 =
-                    hasError ? sum.stderrUpperWm2 + std::pow(a * leaf.stderrUpperWm2, 2) : -1.0;
-                sum.stderrLowerWm2 =
-                    hasError ? sum.stderrLowerWm2 + std::pow(a * leaf.stderrLowerWm2, 2) : -1.0;
-                sum.stderrAbsorbedW =
-                    hasError ? sum.stderrAbsorbedW + std::pow(leaf.stderrAbsorbedW, 2) : -1.0;
-            }
-        }
+        if (!solution.unsolved.empty() && solution.unsolved[r]) continue;
+        for (NodeId at = receiver.node; at != kNoParent; at = byId.at(at)->parent)
+            add(sums[at], 1, receiver.areaM2, solution.light[r]);
+    }
+    // Those solved whole, into themselves and the structures above them.
+    for (const StructureLight& whole : solution.wholeStructures) {
+        for (NodeId at = whole.node; at != kNoParent; at = byId.at(at)->parent)
+            add(sums[at], whole.organCount, whole.areaM2, whole.bands);
     }
     std::vector<StructureLight> result;
     for (const Node& node : scene.nodes) {

@@ -82,13 +82,6 @@ struct LinkAudit {
     double handedW = 0.0, foundW = 0.0, foundStderrW = 0.0;
 };
 
-struct Solution {
-    std::vector<std::vector<BandLight>> light;  // [receiver][band]
-    std::vector<EnergyBalance> balance;         // [band]
-    SolveStats stats;
-    std::vector<LinkAudit> linkAudit;  // HRC with auditLinks only
-};
-
 // The same quantities for a botanical structure (branch, plant, …): the organs below it,
 // area-weighted for irradiances, summed for absorbed power and radiance integrals.
 struct StructureLight {
@@ -100,7 +93,22 @@ struct StructureLight {
     std::vector<BandLight> bands;
 };
 
-// Aggregates for every node that has organs below it (itself included).
+struct Solution {
+    std::vector<std::vector<BandLight>> light;  // [receiver][band]
+    // Structures solved as a whole, their leaves not one by one (the instanced solver
+    // stopped opening there: InstancedOptions::maxDepth, openUntil): the light of each as
+    // one, its irradiances NaN (not solved); their organs are `unsolved` (1 by receiver)
+    // and left out of the organ results. Both empty for the other solvers.
+    std::vector<StructureLight> wholeStructures;
+    std::vector<std::uint8_t> unsolved;
+    std::vector<EnergyBalance> balance;  // [band]
+    SolveStats stats;
+    std::vector<LinkAudit> linkAudit;  // HRC with auditLinks only
+};
+
+// Aggregates for every node that has organs below it (itself included), from the solved
+// organs and the structures solved whole; a structure holding one of those has NaN
+// irradiances (not solved), its absorbed power and light vector summed as the others.
 std::vector<StructureLight> AggregateStructures(const Scene& scene, const FlatScene& flat,
                                                 const Solution& solution);
 
