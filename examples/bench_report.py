@@ -8,7 +8,8 @@ between its `<!-- report:NAME -->` and `<!-- /report:NAME -->` markers, so that 
 what the last run measured and nothing else: docs/results.md holds every table (one section
 per scene), README.md one summary of the error tables (`report:summary`).
 
-Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,scaling,phase,phase-db,phase-spread,growth] [--scenes a,b]
+Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth]
+                      [--scenes a,b]
                       [--scaling-solvers hrc,mc]
        bench_report.py --tables-only [--only ...]   # rewrite from examples/report/, run nothing
 The growth part reads the demo's out/demo/ (run scripts/demo.sh first).
@@ -34,11 +35,13 @@ SCENES = {
                ["--reference-samples", "8192", "--hrc-epsilon", "1e-3,1e-4,1e-5,1e-6"]),
     "tree10k": (["--leaves", "10000", "--seed", "2", "--sky-cones", "turtle46"],
                 "generated tree, 10,000 leaves, sun + 46-cone overcast sky",
-                ["--reference-samples", "8192", "--hrc-epsilon", "1e-3,1e-4,5e-5,1e-5,1e-6"]),
+                ["--reference-samples", "8192", "--hrc-epsilon", "1e-3,1e-4,5e-5,1e-5,1e-6",
+                 "--instanced-epsilon", "1e-3,1e-4,1e-5", "--instanced-depth", "3,4"]),
     "tree119k": (["--leaves", "44500", "--seed", "2", "--sky-cones", "turtle46"],
                  "generated tree of 119k triangles (44,500 leaves and their internodes), "
                  "sun + 46-cone overcast sky",
-                 ["--reference-samples", "4096", "--hrc-epsilon", "1e-3,1e-4,1e-5"]),
+                 ["--reference-samples", "4096", "--hrc-epsilon", "1e-3,1e-4,1e-5",
+                  "--instanced-epsilon", "1e-3,1e-4,1e-5", "--instanced-depth", "4,5"]),
     "canopy": (["--random-canopy", "--canopy-leaves", "2000", "--lai", "5", "--canopy-width", "2",
                 "--seed", "3", "--sky-cones", "turtle46"],
                "dense random canopy, 2,000 leaves, LAI 5, NIR ρ = τ = 0.45, sun + 46-cone sky",
@@ -231,6 +234,51 @@ def phase_sections(build, out, run=True):
     return "\n".join(table), "\n".join(times)
 
 
+def problems_section(build, out, run=True):
+    """The instanced solver's local problems on the 119k tree at ε = 1e-4 (the paper's
+    Fig. 14, right): `leaflux solve --problems`, a histogram of their sizes, and a table
+    by depth."""
+    csv_path = os.path.join(REPORT, "problems_tree119k.csv")
+    if run:
+        leaflux = os.path.join(build, "server", "leaflux")
+        scene = os.path.join(out, "error", "tree119k.scene.txtpb")
+        if not os.path.exists(scene):
+            subprocess.run([leaflux, "generate", *SCENES["tree119k"][0], "--out", scene], check=True,
+                           capture_output=True)
+        database = os.path.join(out, "problems_phase.db")
+        for _ in range(2):  # the second from the database the first filled
+            subprocess.run([leaflux, "solve", "--scene", scene, "--solver", "instanced", "--epsilon", "1e-4",
+                            "--phase-db", database, "--out", os.path.join(out, "problems_leaves.csv"),
+                            "--problems", csv_path, "--quiet"], check=True, capture_output=True)
+    rows = list(csv.DictReader(open(csv_path)))
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        figure_, axis = plt.subplots(figsize=(6, 3.5))
+        sizes = [int(r["elements"]) for r in rows]
+        bins = [2 ** k for k in range(0, max(sizes).bit_length() + 1)]
+        axis.hist(sizes, bins=bins)
+        axis.set_xscale("log")
+        axis.set_yscale("log")
+        axis.set_xlabel("elements of a local problem")
+        axis.set_ylabel("problems")
+        axis.set_title("tree119k, instanced, ε = 1e-4")
+        figure_.tight_layout()
+        figure_.savefig(os.path.join(REPORT, "problems_tree119k.png"), dpi=110)
+    except ImportError:
+        print("no matplotlib: no histogram", file=sys.stderr)
+    table = [f"![local problems]({figure(RESULTS, 'problems_tree119k.png')})", "",
+             "| depth | problems | triangles (mean) | closed instances (mean) | elements (mean) | "
+             "links (mean) | seconds (sum, both threads) |", "|---|---|---|---|---|---|---|"]
+    for depth in sorted({int(r["depth"]) for r in rows}):
+        at = [r for r in rows if int(r["depth"]) == depth]
+        mean = lambda column: number(sum(float(r[column]) for r in at) / len(at))
+        table.append(f"| {depth} | {len(at):,} | {mean('triangles')} | {mean('closed')} | {mean('elements')} | "
+                     f"{mean('links')} | {number(sum(float(r['seconds']) for r in at))} |")
+    return "\n".join(table)
+
+
 def phase_db_section(build, out, run=True):
     """Runs leaflux_bench_phase_db: the database's miss, hit and load times and its size on
     disk against the number of functions it holds."""
@@ -285,7 +333,7 @@ def main():
                         help="build directory (default: build/release)")
     parser.add_argument("out", nargs="?", default=os.path.join(ROOT, "out", "report"),
                         help="directory of the runs' files (default: out/report)")
-    parser.add_argument("--only", default="error,scaling,phase,phase-db,phase-spread,growth",
+    parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth",
                         help="parts to run (default: all)")
     parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
     parser.add_argument("--scaling-solvers", default="hrc,mc",
@@ -305,6 +353,8 @@ def main():
             # Each table is written as soon as it is measured.
             update(RESULTS, f"error-{name}", error_section(build, os.path.join(out, "error"), name, run))
         update(README, "summary", summary_section(list(SCENES)))
+    if "problems" in parts:
+        update(RESULTS, "problems", problems_section(build, out, run))
     if "scaling" in parts:
         update(RESULTS, "scaling", scaling_section(build, os.path.join(out, "scaling"), args.scaling_solvers, run))
     if "phase" in parts:

@@ -212,12 +212,12 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
             runs.push_back(tau);
             // Stopping early, compared per structure solved whole (absorbed power).
             Run branches = run;
-            branches.setting += " output=axis";
+            branches.setting += " output=axis per-structure";
             branches.settings.instanced.outputLevel = NodeType::kAxis;
             runs.push_back(branches);
             for (int depth : options.instancedDepths) {
                 Run shallow = run;
-                shallow.setting += " depth=" + std::to_string(depth);
+                shallow.setting += " depth=" + std::to_string(depth) + " per-structure";
                 shallow.settings.instanced.maxDepth = depth;
                 runs.push_back(shallow);
             }

@@ -4,12 +4,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
+#include <sstream>
+#include <string>
 #include <unordered_map>
 
 #include "solver/generate/generator.h"
 #include "solver/results/accuracy.h"
+#include "solver/results/export.h"
 #include "solver/solve.h"
 #include "tests/scene_builders.h"
 
@@ -162,6 +166,23 @@ TEST(Instanced, APlantSolvedWholeAbsorbsWhatItsLeavesDo) {
                 << whole.name << " band " << b;
         }
     }
+    // The organ CSV holds no organ solved whole; the structures' have no irradiance there.
+    std::ostringstream organs, structures;
+    WriteLeafCsv(organs, scene, prepared.Flat(), solution);
+    const std::string organRows = organs.str();
+    EXPECT_EQ(std::count(organRows.begin(), organRows.end(), '\n'), 1);  // the header
+    WriteStructureCsv(structures, scene, AggregateStructures(scene, prepared.Flat(), solution));
+    std::istringstream lines(structures.str());
+    std::string line;
+    std::getline(lines, line);
+    int plants = 0;
+    while (std::getline(lines, line)) {
+        if (line.find(",plant,") == std::string::npos) continue;
+        ++plants;
+        // organs,band,area_m2, then irradiance_upper and _lower empty.
+        EXPECT_NE(line.find(",,,"), std::string::npos) << line;
+    }
+    EXPECT_EQ(plants, 4 * 2);  // four plants, two bands
 }
 
 // Rigid motion of the whole scene: the same light, for instances carry their frames.
