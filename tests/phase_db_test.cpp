@@ -156,13 +156,20 @@ TEST(PhaseDbCodec, DamagedBlobsAreParseErrors) {
     version[4] = kOriginalFormatVersion + 1;
     auto kind = blob;
     kind[4 + 1 + 48 + 8 + 4 + 34 * 4] = 9;  // the phase kind byte, after τ of 34 values
-    for (const auto* damaged : {&truncated, &longer, &version, &kind}) {
+    // An absorption of one channel for f's two bands: lookups of the second would run past it.
+    Original oneChannel = SyntheticOriginal(PhaseKind::kMonoDirectional, 2, 2, 1);
+    oneChannel.absorption = SphereFunction(2, 1);
+    auto channels = EncodeOriginal(oneChannel);
+    for (const auto* damaged : {&truncated, &longer, &version, &kind, &channels}) {
         try {
             DecodeOriginal(*damaged, "row 1");
             ADD_FAILURE() << "a damaged blob of " << damaged->size() << " bytes decoded";
         } catch (const InputError& e) {
             EXPECT_EQ(e.Code(), ErrorCode::kParse);
             EXPECT_NE(e.Field().find("row 1"), std::string::npos) << e.what();
+            if (damaged == &channels) {
+                EXPECT_EQ(e.Field(), "row 1.absorption.channels");
+            }
         }
     }
 }

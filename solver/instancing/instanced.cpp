@@ -179,9 +179,7 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
         const std::shared_ptr<const Original>& original =
             originals_.bySignature.at(instance.signature);
         closed.contents = std::make_shared<OriginalContents>(
-            original, original->provenance.leafAreaM2 > 0.0
-                          ? instance.leafAreaM2 / original->provenance.leafAreaM2
-                          : 1.0);
+            original, MemberScale(*original, instance.leafAreaM2));
         level->closed.push_back(std::move(closed));
         level->closedPart.push_back(q);
     }
@@ -338,9 +336,7 @@ void InstancedSolve::SolveWhole(const Level& level, const LevelSolution& light, 
     const InstanceTree::Part& part = tree_[q];
     const Node& root = scene_.nodes[part.rootIndex];
     const Original& original = *originals_.bySignature.at(part.signature);
-    const double scale = original.provenance.leafAreaM2 > 0.0
-                             ? part.leafAreaM2 / original.provenance.leafAreaM2
-                             : 1.0;
+    const double scale = MemberScale(original, part.leafAreaM2);
     const glm::dvec3 extent = original.boxMax - original.boxMin;
     const ClosedNode& closed = level.closed[c];
     const int channels = static_cast<int>(scene_.bands.size());

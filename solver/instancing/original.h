@@ -37,10 +37,16 @@ struct Original {
     OriginalProvenance provenance;
 };
 
+// What a member of a signature group with organ area `areaM2` scales its group's original
+// by: its area over the representative's.
+inline double MemberScale(const Original& original, double areaM2) {
+    return original.provenance.leafAreaM2 > 0.0 ? areaM2 / original.provenance.leafAreaM2 : 1.0;
+}
+
 // An original as the radiosity engine's closed nodes see it (closed_node.h). A member of a
 // signature group takes its group's original with its phase function scaled by its organ
 // area over the representative's (`phaseScale`), for a structure intercepts and scatters in
-// proportion to its area.
+// proportion to its area (MemberScale).
 class OriginalContents : public ClosedContents {
   public:
     explicit OriginalContents(std::shared_ptr<const Original> original, double phaseScale = 1.0)

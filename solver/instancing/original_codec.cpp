@@ -155,9 +155,15 @@ Original DecodeOriginal(std::span<const std::uint8_t> blob, const std::string& w
             const auto absorptionLevel = in.Get<std::int32_t>("absorption.level");
             const auto absorptionChannels = in.Get<std::int32_t>("absorption.channels");
             std::vector<float> absorption = in.GetFloats("absorption.values");
-            if (!(absorption.empty() && absorptionChannels == 0))
+            if (!(absorption.empty() && absorptionChannels == 0)) {
+                // Read per band of f: one value a band, or a lookup past its end.
+                if (absorptionChannels != original.phase.Bands())
+                    in.Fail("absorption.channels",
+                            std::to_string(absorptionChannels) + " channels for " +
+                                std::to_string(original.phase.Bands()) + " bands of f");
                 original.absorption = SphereFunction::FromValues(
                     absorptionLevel, absorptionChannels, std::move(absorption));
+            }
         }
     } catch (const std::invalid_argument& e) {
         in.Fail("functions", e.what());

@@ -41,7 +41,7 @@ Occlusion::Chord Occlusion::ChordOf(std::uint32_t c, const glm::dvec3& origin,
     const glm::dvec3 o = glm::dvec3(box.instanceFromScene * glm::dvec4(origin, 1.0));
     const glm::dvec3 d = glm::dmat3(box.instanceFromScene) * direction;
     Chord chord{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
-                glm::normalize(d)};
+                glm::dvec3(0.0)};
     double enter = -std::numeric_limits<double>::infinity();
     double exit = std::numeric_limits<double>::infinity();
     for (int axis = 0; axis < 3; ++axis) {
@@ -57,6 +57,7 @@ Occlusion::Chord Occlusion::ChordOf(std::uint32_t c, const glm::dvec3& origin,
     }
     chord.enter = enter;
     chord.exit = exit;
+    if (exit > enter) chord.direction = glm::normalize(d);  // only for a line that meets it
     return chord;
 }
 

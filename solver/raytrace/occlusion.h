@@ -100,8 +100,8 @@ class Occlusion {
     }
 
     // Where the line from `origin` along `direction` (unit) is inside closed instance c's
-    // box: from enter to exit, distances along the direction (exit < enter: it misses), and
-    // the direction in the instance's frame.
+    // box: from enter to exit, distances along the direction (exit ≤ enter: it misses), and
+    // the direction in the instance's frame (unit; zero when it misses).
     struct Chord {
         double enter, exit;
         glm::dvec3 direction;
