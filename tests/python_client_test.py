@@ -4,9 +4,11 @@ the daemon is slow or gone:
 
 1. a timeout names the endpoint, and the late reply of the request given up on is never
    taken for the answer to the next one;
-2. a request over twice the daemon's limit, which ZeroMQ would cut off unanswered, is
+2. on one connection, replies to other requests and messages that are not a Reply, sent
+   before the answer, are dropped: the reply of the request's own id is taken;
+3. a request over twice the daemon's limit, which ZeroMQ would cut off unanswered, is
    refused with TOO_LARGE at once;
-3. a cycle given `resync=` survives a daemon killed (SIGKILL) and started again on the same
+4. a cycle given `resync=` survives a daemon killed (SIGKILL) and started again on the same
    endpoint: it reconnects, resyncs and sends the cycle again, with the light it would have
    had.
 
@@ -19,7 +21,10 @@ import socket
 import subprocess
 import sys
 import tempfile
+import threading
 import time
+
+import zmq
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "examples"))
 from leaflux_client import Client, LeafluxError, pb  # noqa: E402
@@ -104,6 +109,47 @@ def late_reply_dropped():
         daemon.wait()
 
 
+def stale_replies_dropped():
+    """A stand-in ROUTER answers each request with a late status, a late cycle and a
+    message that is not a Reply before the reply of the request's own id."""
+    router = zmq.Context.instance().socket(zmq.ROUTER)
+    router.setsockopt(zmq.LINGER, 0)
+    router.bind("tcp://127.0.0.1:*")
+    endpoint = router.getsockopt_string(zmq.LAST_ENDPOINT)
+    stop = threading.Event()
+
+    def serve():
+        while not stop.is_set():
+            if not router.poll(50):
+                continue
+            frames = router.recv_multipart()
+            request = pb.Request()
+            request.ParseFromString(frames[-1])
+            late_status = pb.Reply(request_id=request.request_id + 1)
+            late_status.status.session_count = 99
+            late_cycle = pb.Reply(request_id=request.request_id + 1000)
+            late_cycle.cycle.session = "a" * 32
+            own = pb.Reply(request_id=request.request_id)
+            own.status.session_count = 7
+            for message in (late_status.SerializeToString(), late_cycle.SerializeToString(),
+                            b"\xff\xff\xff", own.SerializeToString()):
+                router.send_multipart(frames[:-1] + [message])
+
+    thread = threading.Thread(target=serve)
+    thread.start()
+    try:
+        with Client(endpoint, timeout_s=5) as client:
+            for i in range(3):
+                count = client.status().session_count
+                if count != 7:
+                    fail(f"status {i} took another request's reply (session_count {count})")
+    finally:
+        stop.set()
+        thread.join()
+        router.close()
+    print("on one connection, stale replies and non-Replies are dropped")
+
+
 def too_large_refused():
     daemon, endpoint = start(max_message_mb=1)
     try:
@@ -157,5 +203,6 @@ def survives_a_restart():
 
 if __name__ == "__main__":
     late_reply_dropped()
+    stale_replies_dropped()
     too_large_refused()
     survives_a_restart()
