@@ -3,9 +3,10 @@
 client closing its session and opening a new one every 10 cycles (open/close churn).
 
 Writes one CSV row (clients, cycles, seconds, cycles_per_s, p50_ms, p99_ms, rss_before_kb,
-rss_after_kb, rss_growth_kb) and fails when a cycle fails or when the daemon's resident
-memory grows by more than --max-rss-growth-mb between the warm-up (every client through
-one open, 10 cycles and a close) and the end.
+rss_after_kb, rss_growth_kb, rss_bound_kb) and fails when a cycle fails, when the daemon's
+resident memory grows by more than --max-rss-growth-mb (16) between the warm-up (every
+client through one open, 10 cycles and a close) and the end, or when the cycles take more
+than --max-seconds (240): each client then stops where it is, and the soak ends by itself.
 
 Usage: daemon_soak.py --leafluxd BUILD/server/leafluxd [--csv out.csv]
 """
@@ -54,12 +55,15 @@ def rss_kb(pid):
     return -1
 
 
-def client_run(endpoint, index, cycles, churn, latencies, failures):
+def client_run(endpoint, index, cycles, churn, deadline, latencies, failures):
     settings = pb.SolverSettings(solver=pb.SOLVER_KIND_HRC, epsilon=1e-3, threads=1)
     try:
-        with Client(endpoint, timeout_s=60) as client:
+        with Client(endpoint, timeout_s=30) as client:  # a cycle takes milliseconds
             session = None
             for c in range(cycles):
+                if time.monotonic() > deadline:
+                    failures.append(f"client {index}: out of time after {c} cycles")
+                    break
                 if c % churn == 0:
                     if session:
                         client.close(session)
@@ -78,10 +82,11 @@ def client_run(endpoint, index, cycles, churn, latencies, failures):
         failures.append(f"client {index}: {e}")
 
 
-def run_clients(endpoint, clients, cycles, churn):
+def run_clients(endpoint, clients, cycles, churn, seconds):
     latencies, failures = [], []
+    deadline = time.monotonic() + seconds
     threads = [threading.Thread(target=client_run,
-                                args=(endpoint, i, cycles, churn, latencies, failures))
+                                args=(endpoint, i, cycles, churn, deadline, latencies, failures))
                for i in range(clients)]
     start = time.perf_counter()
     for t in threads:
@@ -99,6 +104,8 @@ def main():
     parser.add_argument("--churn", type=int, default=10, help="cycles per session")
     parser.add_argument("--workers", type=int, default=4)
     parser.add_argument("--max-rss-growth-mb", type=float, default=16.0)
+    parser.add_argument("--max-seconds", type=float, default=240.0,
+                        help="time the cycles may take, warm-up included")
     parser.add_argument("--csv")
     args = parser.parse_args()
 
@@ -118,11 +125,15 @@ def main():
             time.sleep(0.02)
         if endpoint is None:
             sys.exit("leafluxd did not start")
-        _, _, failures = run_clients(endpoint, args.clients, args.churn, args.churn)  # warm-up
+        started = time.monotonic()
+        _, _, failures = run_clients(endpoint, args.clients, args.churn, args.churn,
+                                     args.max_seconds)  # warm-up
         if failures:
             sys.exit("warm-up failed: " + "; ".join(failures[:5]))
         before = rss_kb(daemon.pid)
-        seconds, latencies, failures = run_clients(endpoint, args.clients, args.cycles, args.churn)
+        seconds, latencies, failures = run_clients(
+            endpoint, args.clients, args.cycles, args.churn,
+            args.max_seconds - (time.monotonic() - started))
         after = rss_kb(daemon.pid)
         if daemon.poll() is not None:
             sys.exit(f"leafluxd exited with status {daemon.returncode}")
@@ -136,10 +147,11 @@ def main():
     done = len(latencies)
     p50 = 1000 * latencies[done // 2] if done else float("nan")
     p99 = 1000 * latencies[min(done - 1, int(0.99 * done))] if done else float("nan")
+    bound_kb = int(1024 * args.max_rss_growth_mb)
     header = ("clients,cycles,seconds,cycles_per_s,p50_ms,p99_ms,rss_before_kb,rss_after_kb,"
-              "rss_growth_kb")
+              "rss_growth_kb,rss_bound_kb")
     row = (f"{args.clients},{done},{seconds:.2f},{done / seconds:.1f},{p50:.1f},{p99:.1f},"
-           f"{before},{after},{after - before}")
+           f"{before},{after},{after - before},{bound_kb}")
     print(header)
     print(row)
     if args.csv:
@@ -151,7 +163,7 @@ def main():
         sys.exit(f"{done} cycles answered of {args.clients * args.cycles}")
     if open_sessions != 0:
         sys.exit(f"{open_sessions} sessions left open after every client closed its own")
-    if after - before > 1024 * args.max_rss_growth_mb:
+    if after - before > bound_kb:
         sys.exit(f"RSS grew by {(after - before) / 1024:.1f} MiB "
                  f"(bound {args.max_rss_growth_mb} MiB)")
     print(f"soak passed: RSS grew by {(after - before) / 1024:.1f} MiB "
