@@ -99,9 +99,10 @@ v1::Reply Client::Call(v1::Request request) {
                             endpoint_, timeoutMs / 1000.0, bytes.size())));
         }
         v1::Reply reply;
-        if (!reply.ParseFromString(answer)) {
-            throw ClientError(Failure(v1::ERROR_CODE_PARSE, "the reply from " + endpoint_ +
-                                                                " is not a leaflux.v1.Reply"));
+        if (!reply.ParseFromString(answer)) {  // not a Reply, so not the answer either
+            spdlog::warn("{}: dropped a message of {} bytes that is not a leaflux.v1.Reply",
+                         endpoint_, answer.size());
+            continue;
         }
         // Id 0: the daemon could not read the request's id (it did not decode).
         if (reply.request_id() == id || (reply.request_id() == 0 && reply.has_error())) {

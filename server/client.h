@@ -2,10 +2,10 @@
 // (growth_stub), the command line and the tests; it links the protocol and ZeroMQ only.
 //
 // Every request gets a new request id and only the reply of that id is taken: a late reply
-// to a request given up on is dropped. A request unanswered within its timeout is an
-// ERROR_CODE_IO ClientError naming the endpoint, and the connection is made anew. Before
-// sending a request of over 1 MiB the client learns the daemon's message limit (Status,
-// once a connection) and refuses a request over it with ERROR_CODE_TOO_LARGE: ZeroMQ would
+// to a request given up on, or a message that is not a Reply, is dropped. A request unanswered
+// within its timeout is an ERROR_CODE_IO ClientError naming the endpoint, and the connection is
+// made anew. Before sending a request of over 1 MiB the client learns the daemon's message limit
+// (Status, once a connection) and refuses a request over it with ERROR_CODE_TOO_LARGE: ZeroMQ would
 // cut off one over twice the limit unanswered.
 #pragma once
 

@@ -1,11 +1,15 @@
 // The C++ client when the daemon is slow or gone: a timeout names the endpoint, a late
-// reply is never taken for the answer to a later request, and a cycle that goes
-// unanswered is retried once after a reconnection and a Resync.
+// reply is never taken for the answer to a later request (on a new connection or on the
+// same one), and a cycle that goes unanswered is retried once after a reconnection and a
+// Resync.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
+#include <functional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "server/client.h"
 #include "tests/daemon_process.h"
@@ -55,6 +59,74 @@ TEST_F(ClientOnLoopback, ALateReplyIsNeverTakenForTheNextAnswer) {
     EXPECT_EQ(status.sessions(0).cycles(), 1);
     const v1::StatusReply again = client.Status();
     EXPECT_EQ(again.sessions_size(), 0);
+}
+
+// A stand-in for leafluxd: a ROUTER on a loopback port that answers each request with the
+// messages `answer` makes of it, in order. Its socket is used by its own thread alone.
+class StandIn {
+  public:
+    using Answer = std::function<std::vector<std::string>(const v1::Request&)>;
+    explicit StandIn(Answer answer) : socket_(context_, zmq::socket_type::router) {
+        socket_.set(zmq::sockopt::linger, 0);
+        socket_.bind("tcp://127.0.0.1:*");
+        endpoint_ = socket_.get(zmq::sockopt::last_endpoint);
+        thread_ = std::thread([this, answer = std::move(answer)] { Serve(answer); });
+    }
+    ~StandIn() {
+        stop_ = true;
+        thread_.join();
+    }
+    const std::string& Endpoint() const { return endpoint_; }
+
+  private:
+    void Serve(const Answer& answer) {
+        while (!stop_) {
+            zmq::pollitem_t items[] = {{socket_.handle(), 0, ZMQ_POLLIN, 0}};
+            zmq::poll(items, 1, std::chrono::milliseconds(50));
+            if (!(items[0].revents & ZMQ_POLLIN)) continue;
+            std::vector<zmq::message_t> frames;
+            if (!zmq::recv_multipart(socket_, std::back_inserter(frames))) continue;
+            v1::Request request;
+            request.ParseFromArray(frames.back().data(), static_cast<int>(frames.back().size()));
+            for (const std::string& message : answer(request)) {
+                for (std::size_t i = 0; i + 1 < frames.size(); ++i)
+                    socket_.send(zmq::buffer(frames[i].data(), frames[i].size()),
+                                 zmq::send_flags::sndmore);
+                socket_.send(zmq::buffer(message), zmq::send_flags::none);
+            }
+        }
+    }
+
+    zmq::context_t context_;
+    zmq::socket_t socket_;
+    std::string endpoint_;
+    std::atomic<bool> stop_{false};
+    std::thread thread_;
+};
+
+v1::Reply StatusReplyOf(std::uint64_t requestId, int sessions) {
+    v1::Reply reply;
+    reply.set_version(v1::PROTOCOL_VERSION_CURRENT);
+    reply.set_request_id(requestId);
+    reply.mutable_status()->set_session_count(sessions);
+    return reply;
+}
+
+// The case on one connection: before the answer come replies to other requests (a
+// late status, a late cycle) and a message that is not a Reply; the client takes the reply
+// of its own request id and drops the others.
+TEST(ClientReplies, StaleRepliesAndNonRepliesOnOneConnectionAreDropped) {
+    StandIn standIn([](const v1::Request& request) {
+        v1::Reply lateCycle;
+        lateCycle.set_request_id(request.request_id() + 1000);
+        lateCycle.mutable_cycle()->set_session(std::string(32, 'a'));
+        return std::vector<std::string>{
+            StatusReplyOf(request.request_id() + 1, 99).SerializeAsString(),
+            lateCycle.SerializeAsString(), std::string("\xff\xff\xff", 3),
+            StatusReplyOf(request.request_id(), 7).SerializeAsString()};
+    });
+    Client client(standIn.Endpoint(), "", 5000);
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(client.Status().session_count(), 7) << "request " << i;
 }
 
 // No daemon on the endpoint: the client gives up within its timeout with a message that
