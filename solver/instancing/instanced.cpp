@@ -56,6 +56,8 @@ class InstancedSolve {
             const Receiver& receiver = receivers.receivers[r];
             if (receiver.kind == ReceiverKind::kOrgan) {
                 organReceiver_[receiver.node] = r;
+                LEAFLUX_CHECK_EQ(receiver.firstTriangle, organTriangles_);  // organs first
+                organTriangles_ += receiver.triangleCount;
             } else if (firstOther_ == kNoReceiver) {
                 firstOther_ = r;
             }
@@ -73,6 +75,7 @@ class InstancedSolve {
     void Run() {
         const std::unique_ptr<Level> top = Build(InstanceTree::kTop, glm::dmat4(1.0), nullptr, 0);
         LevelSolution light = Solve(InstanceTree::kTop, *top, {});
+        held_ = std::move(light.surfaces);
         errorW_ = light.errorW;
         sourceCount_ = light.sourceCount;
         OpenInstances(*top, light);
@@ -92,6 +95,18 @@ class InstancedSolve {
         if (receiver.kind == ReceiverKind::kOrgan) return organReceiver_.at(receiver.node);
         return firstOther_ + (r - organs);
     }
+    // The top's receivers are all the scene's; an opened part's are its organs, then the
+    // surfaces it holds.
+    static std::uint32_t OwnReceivers(std::uint32_t p, const FlatScene& flat) {
+        return p == InstanceTree::kTop ? static_cast<std::uint32_t>(flat.receivers.size())
+                                       : OrganCount(flat);
+    }
+    static std::uint32_t OrganTriangles(const FlatScene& flat) {
+        const std::uint32_t organs = OrganCount(flat);
+        if (organs == flat.receivers.size())
+            return static_cast<std::uint32_t>(flat.triangles.size());
+        return flat.receivers[organs].firstTriangle;
+    }
     static std::uint32_t OrganCount(const FlatScene& flat) {
         std::uint32_t organs = 0;
         while (organs < flat.receivers.size() &&
@@ -99,9 +114,11 @@ class InstancedSolve {
             ++organs;
         return organs;
     }
-    ShadowView ShadowsOf(const FlatScene& flat) const;
+    ShadowView ShadowsOf(std::uint32_t p, const FlatScene& flat) const;
     // The light that arrived on closed instance c of `level`, as the sources of its contents.
     std::vector<DirectionalSource> ArrivedOn(const LevelSolution& light, std::size_t c) const;
+    // The cone of light of bin d holding `normalIrradiance`.
+    DirectionalSource BinCone(int d, std::vector<double> normalIrradiance) const;
     void OpenInstances(const Level& level, const LevelSolution& light);
     // Whether part q is opened (InstancedOptions::maxDepth, outputLevel).
     bool Opens(std::uint32_t q) const;
@@ -122,6 +139,9 @@ class InstancedSolve {
     const DirectionSet& directions_;
     std::unordered_map<NodeId, std::uint32_t> organReceiver_;
     std::uint32_t firstOther_ = kNoReceiver;  // the first environment surface or emitter
+    std::uint32_t organTriangles_ = 0;        // of the receivers, the organs' first
+    // The top's surfaces as solved, which every opened instance holds (ReceiverKind::kHeld).
+    std::vector<LevelSolution::SurfacePatch> held_;
     double errorW_ = 0.0;
     std::size_t sourceCount_ = 0;
     std::mutex statsMutex_;
@@ -138,6 +158,22 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
     if (p == InstanceTree::kTop) {
         local.environment = scene_.environment;
         local.sources = scene_.sources;
+    } else {
+        // The top's surfaces, each patch side that sends light an emitter of its own.
+        for (const LevelSolution::SurfacePatch& patch : held_) {
+            for (int side : {kUpper, kLower}) {
+                const std::vector<double>& exitance = side == kUpper ? patch.upper : patch.lower;
+                if (std::none_of(exitance.begin(), exitance.end(),
+                                 [](double e) { return e > 0.0; }))
+                    continue;
+                auto mesh = std::make_shared<Mesh>();
+                mesh->positions = {patch.a, side == kUpper ? patch.b : patch.c,
+                                   side == kUpper ? patch.c : patch.b};
+                mesh->triangles = {{0, 1, 2}};
+                Emitter held{"held surface", std::move(mesh), exitance, "", true};
+                local.sources.emitters.push_back(std::move(held));
+            }
+        }
     }
     local.nodes.reserve(part.nodes.size());
     for (std::size_t i : part.nodes) {
@@ -183,7 +219,11 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
         level->closed.push_back(std::move(closed));
         level->closedPart.push_back(q);
     }
-    level->rays = std::make_unique<RayScene>(level->flat, std::nullopt);
+    // An opened part's rays meet its own organs; the surfaces it holds are seen by their
+    // links alone.
+    level->rays = std::make_unique<RayScene>(
+        level->flat, std::nullopt, RayDevice::Shared(),
+        p == InstanceTree::kTop ? kNoTriangle : OrganTriangles(level->flat));
     std::vector<ClosedProxy> proxies;
     for (const ClosedNode& closed : level->closed) proxies.push_back(closed.Proxy());
     OutsideView view;
@@ -192,16 +232,16 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
             outside->occlusion.get(), {indexOutside}, level->flat.origin - outside->flat.origin};
     }
     level->occlusion = std::make_unique<Occlusion>(*level->rays, std::move(proxies),
-                                                   std::move(view), ShadowsOf(level->flat));
+                                                   std::move(view), ShadowsOf(p, level->flat));
     return level;
 }
 
-ShadowView InstancedSolve::ShadowsOf(const FlatScene& flat) const {
+ShadowView InstancedSolve::ShadowsOf(std::uint32_t p, const FlatScene& flat) const {
     if (shadows_ == nullptr) return {};
-    ShadowView view{shadows_, std::vector<std::uint32_t>(flat.triangles.size()),
-                    flat.origin - receivers_.origin};
+    ShadowView view{shadows_, std::vector<std::uint32_t>(flat.triangles.size(), kNoTriangle),
+                    flat.origin - receivers_.origin, organTriangles_};
     const std::uint32_t organs = OrganCount(flat);
-    for (std::uint32_t r = 0; r < flat.receivers.size(); ++r) {
+    for (std::uint32_t r = 0; r < OwnReceivers(p, flat); ++r) {
         const Receiver& local = flat.receivers[r];
         const Receiver& whole = receivers_.receivers[Global(flat, organs, r)];
         LEAFLUX_CHECK_EQ(local.triangleCount, whole.triangleCount);
@@ -219,12 +259,13 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     problem.sources = std::move(sources);
     problem.errorW = errorW_;
     problem.sourceCount = sourceCount_;
+    problem.splitSurfaces = true;  // the surfaces' light, held by the contents (Build)
     LevelSolution light = SolveLevel(level.scene, level.flat, *level.rays, options_.hrc,
                                      level.closed, std::move(problem));
     // Its receivers' light, where the scene has them.
     const FlatScene& flat = level.flat;
     const std::uint32_t organs = OrganCount(flat);
-    for (std::uint32_t r = 0; r < flat.receivers.size(); ++r)
+    for (std::uint32_t r = 0; r < OwnReceivers(p, flat); ++r)
         out_.solution.light[Global(flat, organs, r)] = std::move(light.solution.light[r]);
     InstancedStats::Problem size;
     size.depth = tree_[p].depth;
@@ -256,9 +297,19 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     return light;
 }
 
+DirectionalSource InstancedSolve::BinCone(int d, std::vector<double> normalIrradiance) const {
+    DirectionalSource cone{directions_.Direction(d), std::move(normalIrradiance),
+                           1.0 - directions_.HatIntegralSr(d) / (2.0 * std::numbers::pi)};
+    cone.incident = false;  // scattered inside the scene
+    return cone;
+}
+
 std::vector<DirectionalSource> InstancedSolve::ArrivedOn(const LevelSolution& light,
                                                          std::size_t c) const {
     const int channels = static_cast<int>(scene_.bands.size());
+    const auto lit = [](const std::vector<double>& e) {
+        return std::any_of(e.begin(), e.end(), [](double v) { return v > 0.0; });
+    };
     std::vector<DirectionalSource> sources;
     // The scene's suns and sky cones, traced again from the contents through everything.
     for (const DirectionalSource& source : light.sources) {
@@ -278,15 +329,19 @@ std::vector<DirectionalSource> InstancedSolve::ArrivedOn(const LevelSolution& li
                     located.weight[j] * visibility * source.normalIrradiance[k];
         }
     }
+    // Less what the surfaces sent: the contents hold those surfaces (Build) and take
+    // their light with its parallax.
     for (int d = 0; d < light.bins; ++d) {
-        DirectionalSource cone{
-            directions_.Direction(d),
-            std::vector<double>(bins.begin() + d * channels, bins.begin() + (d + 1) * channels),
-            1.0 - directions_.HatIntegralSr(d) / (2.0 * std::numbers::pi)};
-        cone.beyond = false;
-        double total = 0.0;
-        for (double e : cone.normalIrradiance) total += e;
-        if (total > 0.0) sources.push_back(std::move(cone));
+        std::vector<double> e(bins.begin() + d * channels, bins.begin() + (d + 1) * channels);
+        if (!light.surfaceBins.empty()) {
+            for (int k = 0; k < channels; ++k)
+                e[k] = std::max(0.0, e[k] - light.surfaceBins[c][d * channels + k]);
+        }
+        if (lit(e)) {
+            DirectionalSource cone = BinCone(d, std::move(e));
+            cone.beyond = false;  // what it met outside, its irradiance holds
+            sources.push_back(std::move(cone));
+        }
     }
     return sources;
 }
@@ -374,7 +429,7 @@ void InstancedSolve::SolveWhole(const Level& level, const LevelSolution& light, 
         const double visibility = light.sourceVisibility[c][s];
         if (visibility <= 0.0) continue;
         for (int k = 0; k < channels; ++k) e[k] = visibility * light.sources[s].normalIrradiance[k];
-        arrive(light.sources[s].toward, e.data(), light.sources[s].beyond);
+        arrive(light.sources[s].toward, e.data(), light.sources[s].incident);
     }
     for (int d = 0; d < light.bins; ++d)
         arrive(directions_.Direction(d), light.arrivedBins[c].data() + d * channels, false);

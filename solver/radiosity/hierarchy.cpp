@@ -75,9 +75,18 @@ Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat, std::span<const 
     for (NodeId root : roots) {
         if (const auto it = built.find(root); it != built.end()) top.push_back(it->second);
     }
+    // Surfaces held from outside a local problem in clusters of their own, so that a
+    // sender is held or not.
+    std::vector<std::uint32_t> held;
     for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
-        if (flat.receivers[r].kind != ReceiverKind::kOrgan) top.push_back(receiverNode[r]);
+        const ReceiverKind kind = flat.receivers[r].kind;
+        if (kind == ReceiverKind::kHeld) {
+            held.push_back(receiverNode[r]);
+        } else if (kind != ReceiverKind::kOrgan) {
+            top.push_back(receiverNode[r]);
+        }
     }
+    if (!held.empty()) top.push_back(held.size() == 1 ? held[0] : Constrain(std::move(held)));
     if (const auto it = closedOf.find(kNoParent); it != closedOf.end())
         top.insert(top.end(), it->second.begin(), it->second.end());
     for (const ClosedNode& node : closed_) {

@@ -159,6 +159,8 @@ class SceneSolve {
     void Patches(BeamSolution& beams) const;
     // After Run: what arrived on each closed instance, and the threshold the links took.
     void Arrived(LevelSolution& level) const;
+    // Of that, per closed instance, what the links from surfaces brought.
+    std::vector<std::vector<double>> SurfaceBins() const;
 
   private:
     void Solve(Solution& solution);
@@ -280,7 +282,8 @@ void SceneSolve::Index() {
             continue;
         }
         const Receiver& receiver = flat_.receivers[node.receiver];
-        if (receiver.kind != ReceiverKind::kEmitter) continue;
+        if (receiver.kind != ReceiverKind::kEmitter && receiver.kind != ReceiverKind::kHeld)
+            continue;
         const auto& exitance = scene_.sources.emitters[receiver.emitter].exitanceWm2;
         for (int b = 0; b < channels_.bands; ++b) leafLight_.emission[n][b] = exitance[b];
     }
@@ -296,10 +299,10 @@ void SceneSolve::OnSplit(std::uint32_t n) {
         sourceLight_.sides.Resize(size);
         sourceLight_.integral.Resize(size);
         sourceLight_.moment.Resize(size);
-        sourceLight_.beyond.Resize(size);
+        sourceLight_.incident.Resize(size);
         for (std::uint32_t child : hierarchy_[n].children) {
             sourceLight_.sides.CopyRow(child, n);
-            sourceLight_.beyond.CopyRow(child, n);
+            sourceLight_.incident.CopyRow(child, n);
             sourceLight_.integral.CopyRow(child, n);
             sourceLight_.moment.CopyRow(child, n);
         }
@@ -409,8 +412,8 @@ void SceneSolve::Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock)
                 // Light that arrived on an opened instance from the rest of the scene was
                 // incident there already: its balance counts the suns' and sky's alone.
                 if (std::any_of(sources_.begin(), sources_.end(),
-                                [](const DirectionalSource& s) { return !s.beyond; }))
-                    leafLight_.direct = sourceLight_.beyond;
+                                [](const DirectionalSource& s) { return !s.incident; }))
+                    leafLight_.direct = sourceLight_.incident;
             }
             residual = options_.directOnly ? UpdateRadiosity(hierarchy_, traversal_.Leaves(),
                                                              optics_, leafLight_, field_)
@@ -532,6 +535,47 @@ void SceneSolve::Arrived(LevelSolution& level) const {
         std::copy_n(closedLight_.bins[c], width, level.arrivedBins[c].begin());
         std::copy_n(closedLight_.sources[c], sources_.size(), level.sourceVisibility[c].begin());
     }
+    if (!level_.splitSurfaces) return;
+    level.surfaceBins = SurfaceBins();
+    for (std::uint32_t n : traversal_.Leaves()) {
+        const HrcNode& node = hierarchy_[n];
+        if (!node.patch || model_.HoldsOrgans(n) || model_.Held(n)) continue;
+        const glm::dvec3 o = flat_.origin;
+        const double* upper = field_.radiosity(n, kUpper);
+        const double* lower = field_.radiosity(n, kLower);
+        level.surfaces.push_back({node.a + o, node.b + o, node.c + o,
+                                  std::vector<double>(upper, upper + channels_.Count()),
+                                  std::vector<double>(lower, lower + channels_.Count())});
+    }
+}
+
+std::vector<std::vector<double>> SceneSolve::SurfaceBins() const {
+    // The links from surfaces alone, gathered and pushed down as the sweeps do.
+    const std::size_t size = hierarchy_.Size();
+    Links plain;
+    plain.Resize(size);
+    for (std::uint32_t r : traversal_.Receivers()) {
+        for (const NodeLink& link : active_->node[r]) {
+            if (!model_.HoldsOrgans(link.sender)) plain.node[r].push_back(link);
+        }
+    }
+    Gathered gathered(channels_, model_.BinCount());
+    gathered.bins.Assign(model_.SlotCount());
+    gathered.sides.Assign(size);
+    gathered.integral.Assign(size);
+    gathered.moment.Assign(size);
+    Gather<false>(model_, field_, plain, traversal_.Receivers(), gathered);
+    SourceLight none(channels_);
+    none.sides.Assign(size);
+    LeafLight leaves(channels_);
+    leaves.Resize(size);
+    ClosedLight arrived(channels_, model_.BinCount(), hierarchy_.Closed().size(), sources_.size());
+    pushPull_.PushDown<false>(plain, gathered, none, leaves, &arrived);
+    const std::size_t width = static_cast<std::size_t>(model_.BinCount()) * channels_.Count();
+    std::vector<std::vector<double>> bins(hierarchy_.Closed().size());
+    for (std::size_t c = 0; c < bins.size(); ++c)
+        bins[c].assign(arrived.bins[c], arrived.bins[c] + width);
+    return bins;
 }
 
 void SceneSolve::Patches(BeamSolution& beams) const {

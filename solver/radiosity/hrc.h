@@ -151,6 +151,9 @@ struct LevelProblem {
     // (Thresholds); errorW 0: ε times the power the sources bring onto its organs.
     double errorW = 0.0;
     std::size_t sourceCount = 0;
+    // Whether to tell apart, of what arrived on each closed instance, the light of the
+    // level's surfaces (LevelSolution::surfaceBins), and to hand them on (surfaces).
+    bool splitSurfaces = false;
 };
 struct LevelSolution {
     Solution solution;  // its receivers' light (those of the flat scene given)
@@ -161,6 +164,17 @@ struct LevelSolution {
     // Per closed instance, what arrived on it: from the level's nodes per bin, [bin][channel]
     // in W/m² normal to the bin; and the visibility of each of the level's sources.
     std::vector<std::vector<double>> arrivedBins, sourceVisibility;
+    // With LevelProblem::splitSurfaces: the part of arrivedBins that the links from
+    // surfaces brought (nodes holding no organ nor closed instance: a ground, walls, lamps,
+    // surfaces held from further out), and the level's own surfaces' patches as solved
+    // (not those held), so that an opened instance can hold them (ReceiverKind::kHeld)
+    // and take their light with its parallax across it.
+    std::vector<std::vector<double>> surfaceBins;
+    struct SurfacePatch {
+        glm::dvec3 a, b, c;                // world frame; the upper side by a, b, c
+        std::vector<double> upper, lower;  // exitance per channel (W/m²)
+    };
+    std::vector<SurfacePatch> surfaces;
 };
 LevelSolution SolveLevel(const Scene& scene, const FlatScene& flat, const RayScene& rays,
                          const HrcOptions& options, std::span<const ClosedNode> closed,

@@ -48,12 +48,12 @@ struct Gathered {
 struct SourceLight {
     explicit SourceLight(const Channels& channels)
         : sides(channels.Count()),
-          beyond(channels.Count()),
+          incident(channels.Count()),
           integral(channels.Count()),
           moment(channels.Count()) {}
 
     SideTable sides;
-    SideTable beyond;  // of it, what the sources beyond a local problem bring (its incident)
+    SideTable incident;  // of it, what the suns and sky cones bring (DirectionalSource::incident)
     Table<double> integral;
     Table<glm::dvec3> moment;
 };

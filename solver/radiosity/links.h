@@ -118,6 +118,9 @@ struct DirectionalSource {
     // scene's suns and sky cones; false for the light that arrived on an opened instance
     // from the rest of the scene, whose shadows outside it that light already holds.
     bool beyond = true;
+    // Light incident on the scene, which its energy balance counts: the suns' and sky's,
+    // not light scattered inside it.
+    bool incident = true;
 };
 
 // The links of one hierarchy, by receiver node.

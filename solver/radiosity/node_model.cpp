@@ -47,21 +47,28 @@ void NodeModel::FindOrgans() {
     maxDepth_.assign(flat_.triangles.size(), static_cast<std::uint8_t>(maxSubdivision_));
     for (std::size_t i = 0; i < flat_.triangles.size() && organsRadius_ > 0.0; ++i) {
         const Triangle& t = flat_.triangles[i];
-        if (flat_.receivers[t.receiver].kind == ReceiverKind::kOrgan) continue;
+        const ReceiverKind kind = flat_.receivers[t.receiver].kind;
+        if (kind == ReceiverKind::kOrgan || kind == ReceiverKind::kHeld) continue;
         const double levels = std::ceil(std::log2(std::sqrt(2.0 * t.areaM2) / organsRadius_)) + 1;
         maxDepth_[i] =
             static_cast<std::uint8_t>(std::clamp(static_cast<int>(levels), maxSubdivision_,
                                                  std::max(maxSubdivision_, kMaxSurfaceDepth)));
     }
     organs_.assign(hierarchy_.Size(), 0);
+    held_.assign(hierarchy_.Size(), 0);
     for (std::uint32_t n = 0; n < hierarchy_.Size(); ++n) {
         const HrcNode& node = hierarchy_[n];
         if (node.patch) {
             organs_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kOrgan;
+            held_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kHeld;
         } else if (node.closed >= 0) {
             organs_[n] = 1;
         } else {
-            for (std::uint32_t child : node.children) organs_[n] |= organs_[child];
+            held_[n] = !node.children.empty();
+            for (std::uint32_t child : node.children) {
+                organs_[n] |= organs_[child];
+                held_[n] &= held_[child];
+            }
         }
     }
 }

@@ -62,6 +62,13 @@ class NodeModel {
     // Whether a link into node r hands the same light to organs that may see it unevenly:
     // r is a cluster with organs under it (a closed instance is one).
     bool Shared(std::uint32_t r) const { return !hierarchy_[r].patch && organs_[r]; }
+    // n holds only surfaces held from outside a local problem (ReceiverKind::kHeld): it
+    // sends its held light and receives nothing.
+    bool Held(std::uint32_t n) const {
+        const HrcNode& node = hierarchy_[n];
+        return node.patch ? flat_.receivers[node.receiver].kind == ReceiverKind::kHeld
+                          : held_[n] != 0;
+    }
     // n is an organ's patch, or a cluster with organs under it.
     bool HoldsOrgans(std::uint32_t n) const {
         const HrcNode& node = hierarchy_[n];
@@ -157,6 +164,7 @@ class NodeModel {
     std::vector<std::uint8_t> inner_;  // by flat triangle: bit s set when side s is inside
     std::vector<std::array<double, 2>> lobeScale_;  // by flat triangle and side: BinCosine
     std::vector<std::uint8_t> organs_;              // by node as built: 1 over an organ
+    std::vector<std::uint8_t> held_;                // by node as built: Held
     std::vector<std::uint8_t> planes_;              // by node as built: Planar
     std::vector<std::uint32_t> slot_;               // by node: clusters' slots, kNoNode for patches
     std::uint32_t slots_ = 0;

@@ -12,10 +12,16 @@
 namespace leaflux {
 
 std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
-                          const std::vector<std::uint32_t>& leaves, const ReceiverOptics& optics,
+                          const std::vector<std::uint32_t>& allLeaves, const ReceiverOptics& optics,
                           const Field& field, const LeafLight& leafLight, LightSink& sink,
                           std::vector<EnergyBalance>& balances) {
     const Hierarchy& hierarchy = model.Nodes();
+    // Surfaces held from outside a local problem have no output and are not in its balance.
+    std::vector<std::uint32_t> leaves;
+    leaves.reserve(allLeaves.size());
+    for (std::uint32_t n : allLeaves) {
+        if (!model.Held(n)) leaves.push_back(n);
+    }
     const int bands = model.ChannelSet().Count();
     LEAFLUX_CHECK(model.ChannelSet().beams == 1);
     std::int64_t traced = 0;

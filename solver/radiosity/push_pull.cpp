@@ -156,7 +156,7 @@ void PushPull::PushSources(const Links& links, const std::vector<DirectionalSour
     const std::size_t size = hierarchy_.Size();
     const int channels = model_.ChannelSet().Count();
     out.sides.Assign(size);
-    out.beyond.Assign(size);
+    out.incident.Assign(size);
     out.integral.Assign(size);
     out.moment.Assign(size);
     const auto holds = [&](std::uint32_t n) { return !links.source[n].empty(); };
@@ -171,13 +171,13 @@ void PushPull::PushSources(const Links& links, const std::vector<DirectionalSour
             const int side = cosine > 0.0 ? kUpper : kLower;
             if (model_.Inner(node.triangle, side)) continue;
             double* sides = out.sides(n, side);
-            double* beyond = sources[s].beyond ? out.beyond(n, side) : nullptr;
+            double* incident = sources[s].incident ? out.incident(n, side) : nullptr;
             double* integral = out.integral[n];
             glm::dvec3* moment = out.moment[n];
             for (int k = 0; k < channels; ++k) {
                 const double normal = sources[s].normalIrradiance[k] * visibility[s];
                 sides[k] += normal * std::abs(cosine);
-                if (beyond) beyond[k] += normal * std::abs(cosine);
+                if (incident) incident[k] += normal * std::abs(cosine);
                 integral[k] += normal;
                 moment[k] += normal * sources[s].toward;
             }

@@ -46,6 +46,7 @@ void Refiner::Refine(std::vector<Task> stack) {
 }
 
 Refiner::Verdict Refiner::Judge(const Task& task) const {
+    if (model_.Held(task.r)) return {};  // sends its held light, receives nothing
     switch (task.kind) {
         case Task::kSource:
             return JudgeSource(task.r, task.s);
@@ -65,7 +66,7 @@ void Refiner::Carry(const Task& task, const Verdict& verdict, std::vector<Task>&
     if (task.kind == Task::kSelf) {
         // A patch does not see itself; a closed instance's phase function holds its own
         // exchanges.
-        if (hierarchy_[r].patch || hierarchy_[r].closed >= 0) return;
+        if (hierarchy_[r].patch || hierarchy_[r].closed >= 0 || model_.Held(r)) return;
         const auto& children = hierarchy_[r].children;
         for (auto i = children.rbegin(); i != children.rend(); ++i) {
             stack.push_back({Task::kSelf, *i, *i});

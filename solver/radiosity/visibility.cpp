@@ -29,12 +29,37 @@ double LinkVisibility::ClosedBrightness(std::int32_t closed, const glm::dvec3& t
     return area > 0.0 ? model_.Power(field_, n, -towardQ) / area : 0.0;
 }
 
+double LinkVisibility::HeldTransmittance(const Hierarchy::Point& p, const glm::dvec3& direction,
+                                         double length) const {
+    const std::int32_t ends[2] = {p.closed, -1};
+    const ShadowView& shadows = occlusion_.Shadows();
+    if (!shadows.rays) {
+        return occlusion_.Transmittance({p.position, p.triangle}, direction, length,
+                                        Exclusion(ends));
+    }
+    // The whole scene's organs, from where the ray leaves a closed instance's box (what its
+    // own contents take of the light is in its phase function).
+    RayStart start{p.position + shadows.offset};
+    double from = 0.0;
+    if (p.closed >= 0) {
+        from = std::max(0.0, occlusion_.ChordOf(p.closed, p.position, direction).exit);
+        start.origin += from * direction;
+    } else {
+        start.triangle = shadows.triangleOf[p.triangle];
+    }
+    if (from >= length) return 1.0;
+    return shadows.rays->OccludedByFirst(start, direction, length - from, shadows.organTriangles)
+               ? 0.0
+               : 1.0;
+}
+
 Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
                               double unoccluded) const {
     Random random(StreamSeed(static_cast<std::uint64_t>(set), r, s));
     const int count = visibilityRays_;
     const bool fromCluster = !hierarchy_[s].patch;
     const bool boxes = !occlusion_.TrianglesOnly();
+    const bool held = model_.Held(s);
     double visible = 0.0, total = 0.0, visibleLight = 0.0, totalLight = 0.0;
     int traced = 0;
     double passed = 0.0;
@@ -56,7 +81,7 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std:
         totalLight += light;
         const RayStart start{p.position, p.triangle};
         const double length = distance * (1.0 - 1e-4);
-        if (!boxes) {  // triangles alone: a ray passes or not
+        if (!boxes && !held) {  // triangles alone: a ray passes or not
             if (occlusion_.Triangles().Occluded(start, d / distance, length)) continue;
             visible += weight;
             visibleLight += light;
@@ -65,7 +90,8 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std:
         }
         const std::int32_t ends[2] = {p.closed, q.closed};
         const double through =
-            occlusion_.LocalTransmittance(start, d / distance, length, Exclusion(ends));
+            held ? HeldTransmittance(p, d / distance, length)
+                 : occlusion_.LocalTransmittance(start, d / distance, length, Exclusion(ends));
         visible += weight * through;
         visibleLight += light * through;
         passed += through;

@@ -76,6 +76,9 @@ class LinkVisibility {
     // (Occlusion::LocalTransmittance): the rest of the scene's shadow on its inner
     // exchanges is left out (on the 10k tree, no worse for 40 % less time).
     // Counts the rays it traces in `rays`.
+    // From a surface held from outside a local problem (NodeModel::Held), the rays meet the
+    // whole scene's organs where the occlusion has them (ShadowView: exact shadows), else
+    // what lies outside the problem as well (Occlusion::Transmittance).
     Sight Between(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
                   double unoccluded = 0.0) const;
 
@@ -88,6 +91,9 @@ class LinkVisibility {
                       std::int64_t& rays) const;
 
   private:
+    // Along a ray from p towards a held surface, `length` long.
+    double HeldTransmittance(const Hierarchy::Point& p, const glm::dvec3& direction,
+                             double length) const;
     // What a sender's point q sends towards the ray (from the receiver, towardQ), all
     // channels: the radiosity of a patch's side facing it, a closed instance's radiance.
     double Brightness(const Hierarchy::Point& q, const glm::dvec3& towardQ) const {

@@ -59,6 +59,7 @@ struct ShadowView {
     const RayScene* rays = nullptr;
     std::vector<std::uint32_t> triangleOf;
     glm::dvec3 offset{0.0};
+    std::uint32_t organTriangles = 0;  // the whole scene's first triangles are its organs'
 };
 
 class Occlusion {

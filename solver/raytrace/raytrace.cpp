@@ -28,11 +28,13 @@ int CopyIndex(int i, int j) {
 
 // The intersect context with the periodic copy of the triangle rays leave from; the ray's
 // id holds that triangle, which the filter ignores. With a group (RayScene::OccludedByGroup),
-// only the group's triangles in the tile itself count.
+// only the group's triangles in the tile itself count; with a limit, only the triangles
+// before it.
 struct StartContext {
     RTCIntersectContext context;
     int copy;
     const RayScene::Group* group = nullptr;
+    std::uint32_t limit = kNoTriangle;
 };
 
 void IgnoreStartTriangle(const RTCFilterFunctionNArguments* args) {
@@ -40,10 +42,11 @@ void IgnoreStartTriangle(const RTCFilterFunctionNArguments* args) {
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
         const unsigned triangle = RTCRayN_id(args->ray, args->N, i);
-        if (triangle == kNoTriangle && !start->group) continue;
+        if (triangle == kNoTriangle && !start->group && start->limit == kNoTriangle) continue;
         const unsigned instance = RTCHitN_instID(args->hit, args->N, i, 0);
         const int copy = instance == RTC_INVALID_GEOMETRY_ID ? 0 : static_cast<int>(instance);
         const unsigned primitive = RTCHitN_primID(args->hit, args->N, i);
+        if (primitive >= start->limit) args->valid[i] = 0;
         if (primitive == triangle && copy == start->copy) args->valid[i] = 0;
         if (const RayScene::Group* group = start->group) {
             const std::uint32_t rank = group->rank[primitive];
@@ -107,15 +110,15 @@ std::shared_ptr<RayDevice> RayDevice::Shared() {
 }
 
 RayScene::RayScene(const FlatScene& flat, std::optional<PeriodicDomain> periodic,
-                   std::shared_ptr<RayDevice> device)
+                   std::shared_ptr<RayDevice> device, std::uint32_t triangles)
     : flat_(flat), periodic_(periodic), device_(std::move(device)) {
     SetFlushToZero();
     RTCDevice rtc = device_->Get();
     mesh_ = rtcNewScene(rtc);
     rtcSetSceneBuildQuality(mesh_, RTC_BUILD_QUALITY_HIGH);
-    if (!flat.triangles.empty()) {
+    const std::size_t count = std::min<std::size_t>(flat.triangles.size(), triangles);
+    if (count > 0) {
         RTCGeometry geometry = rtcNewGeometry(rtc, RTC_GEOMETRY_TYPE_TRIANGLE);
-        const std::size_t count = flat.triangles.size();
         auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
             geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * count));
         auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
@@ -276,6 +279,16 @@ void RayScene::Occluded(const std::vector<RayStart>& starts,
                         std::vector<std::uint8_t>& occluded) const {
     OccludedAlong(
         starts, [&](std::size_t i) -> const glm::dvec3& { return directions[i]; }, false, occluded);
+}
+
+bool RayScene::OccludedByFirst(const RayStart& start, const glm::dvec3& direction,
+                               double maxDistance, std::uint32_t triangles) const {
+    LEAFLUX_CHECK(!periodic_);
+    StartContext context = MakeContext(0);
+    context.limit = triangles;
+    RTCRay ray = EmbreeRay(start, direction, maxDistance);
+    rtcOccluded1(top_, &context.context, &ray);
+    return ray.tfar < 0.0f;
 }
 
 template <class Direction>

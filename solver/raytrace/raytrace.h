@@ -66,8 +66,10 @@ class RayScene {
   public:
     // `periodic`: the tile, in the FlatScene's local frame, repeated in x and y. Geometry
     // may overhang the tile by less than one tile width.
+    // `triangles`: the flat scene's first so many alone (all of them by default).
     RayScene(const FlatScene& flat, std::optional<PeriodicDomain> periodic,
-             std::shared_ptr<RayDevice> device = RayDevice::Shared());
+             std::shared_ptr<RayDevice> device = RayDevice::Shared(),
+             std::uint32_t triangles = kNoTriangle);
     ~RayScene();
     RayScene(const RayScene&) = delete;
     RayScene& operator=(const RayScene&) = delete;
@@ -86,6 +88,10 @@ class RayScene {
     // The same with a direction per ray (the rays of a cone of light).
     void Occluded(const std::vector<RayStart>& starts, const std::vector<glm::dvec3>& directions,
                   std::vector<std::uint8_t>& occluded) const;
+    // Whether one of the scene's first `triangles` triangles (a flat scene's organs, which
+    // it lists first) lies along the ray within maxDistance. Not periodic.
+    bool OccludedByFirst(const RayStart& start, const glm::dvec3& direction, double maxDistance,
+                         std::uint32_t triangles) const;
 
     // A group of triangles: those whose rank (an index by triangle) lies in [first, last).
     struct Group {

@@ -62,7 +62,7 @@ FlatScene ReceiversOf(const Scene& scene) {
     for (std::size_t e = 0; e < scene.sources.emitters.size(); ++e) {
         const Emitter& emitter = scene.sources.emitters[e];
         flat.receivers.push_back(
-            {emitter.name, ReceiverKind::kEmitter, 0,
+            {emitter.name, emitter.held ? ReceiverKind::kHeld : ReceiverKind::kEmitter, 0,
              emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId),
              static_cast<int>(e)});
         flat.receivers.back().areaM2 = MeshArea(*emitter.mesh, glm::dmat4(1.0));
@@ -87,8 +87,8 @@ FlatScene Flatten(const Scene& scene, const PlacedOrgans& placed) {
     }
     for (std::size_t e = 0; e < scene.sources.emitters.size(); ++e) {
         const Emitter& emitter = scene.sources.emitters[e];
-        Receiver receiver{emitter.name, ReceiverKind::kEmitter, 0,
-                          emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId),
+        Receiver receiver{emitter.name, emitter.held ? ReceiverKind::kHeld : ReceiverKind::kEmitter,
+                          0, emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId),
                           static_cast<int>(e)};
         AddReceiver(PlaceMesh(*emitter.mesh, glm::dmat4(1.0)), std::move(receiver), triangles,
                     flat);

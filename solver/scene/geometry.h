@@ -18,7 +18,10 @@
 
 namespace leaflux {
 
-enum class ReceiverKind { kOrgan, kEnvironment, kEmitter };
+// kHeld: a surface outside a local problem whose light is held as it was solved there
+// (an emitter with Emitter::held): it sends, receives nothing, is outside the energy
+// balance and has no output.
+enum class ReceiverKind { kOrgan, kEnvironment, kEmitter, kHeld };
 
 struct Receiver {
     std::string name;

@@ -78,6 +78,8 @@ struct Emitter {
     std::shared_ptr<const Mesh> mesh;  // world coordinates
     std::vector<double> exitanceWm2;   // per band
     std::string opticsId;              // empty: black (absorbs all it receives)
+    // A surface outside a local problem, its radiosity held (ReceiverKind::kHeld).
+    bool held = false;
 };
 
 struct Sources {
