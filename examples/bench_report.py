@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """The evaluation behind docs/results.md and the README's summary table.
 
 Error against run time on the benchmark scenes (`leaflux bench error`), time and memory against size (bench_scaling.py), the growth of

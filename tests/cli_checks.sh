@@ -4,7 +4,8 @@
 # 1e4; output paths checked (and their folders made) before a solve; generate refuses a
 # scene that cannot fit in memory at once, with its estimate, and options its kind of scene
 # ignores; leaflux-grow's --ply-cycles and stand options; solve's CSV in W and µmol; client
-# cycle --out writes the Python package's CSV and prints a summary.
+# cycle --out writes the Python package's CSV and prints a summary; the example scripts
+# run as they are and answer --help.
 # Usage: cli_checks.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
 leaflux=$1/server/leaflux
@@ -37,6 +38,15 @@ grep -E -- "--samples .*=1024" "$out/solve.help" > /dev/null || fail "solve --he
     fail "generate --help: no leaves default"
 "$grow" --help | grep -E -- "--cycle-timeout .*=60" > /dev/null || fail "leaflux-grow --help"
 "$daemon" --help | grep -E -- "--workers .*=2" > /dev/null || fail "leafluxd --help shows no default"
+
+# The example scripts: runnable as they are (/usr/bin/python3, the execute bit), --help.
+for script in "$source"/examples/*.py; do
+    grep -q '__main__' "$script" || continue  # a module of the others
+    test -x "$script" || fail "$script: no execute bit"
+    test "$(head -1 "$script")" = "#!/usr/bin/python3" || fail "$script: not #!/usr/bin/python3"
+    "$script" --help > "$out/last.log" 2>&1 || fail "$script --help"
+    grep -q "usage:" "$out/last.log" || fail "$script --help gives no usage"
+done
 
 # Whole numbers: 1e4 is 10,000; 1.5 and ten are refused with a sentence.
 "$leaflux" generate --leaves 1e4 --no-sky --out "$out/new/folder/tree.scene.txtpb" > "$out/gen.log"
