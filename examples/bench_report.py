@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """The evaluation behind docs/results.md and the README's summary table.
 
 Error against run time on the benchmark scenes (`leaflux bench error`), time and memory against size (bench_scaling.py), the growth of
@@ -8,7 +8,7 @@ between its `<!-- report:NAME -->` and `<!-- /report:NAME -->` markers, so that 
 what the last run measured and nothing else: docs/results.md holds every table (one section
 per scene), README.md one summary of the error tables (`report:summary`).
 
-Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth]
+Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth,import]
                       [--scenes a,b]
                       [--scaling-solvers hrc,mc]
        bench_report.py --tables-only [--only ...]   # rewrite from examples/report/, run nothing
@@ -298,6 +298,28 @@ def phase_db_section(build, out, run=True):
     return "\n".join(table)
 
 
+def import_section(build, out, run=True, largest="1000000"):
+    """Runs leaflux_bench_import: the importers' read time on OBJ, .can and OPF files of
+    10⁴–10⁶ triangles it generates, and on an OPF the size of a measured plant."""
+    if run:
+        os.makedirs(out, exist_ok=True)
+        subprocess.run([os.path.join(build, "tests", "leaflux_bench_import"),
+                        os.path.join(out, "import.csv"), largest], check=True)
+        shutil.copy(os.path.join(out, "import.csv"), os.path.join(REPORT, "import.csv"))
+    rows = list(csv.DictReader(open(os.path.join(REPORT, "import.csv"))))
+    names = {"obj": "OBJ", "can": "Caribu .can", "opf": "OPF (shared meshes)",
+             "opf-plant": "OPF, a measured plant's size", "opf-plant-z":
+             "OPF, the same with zero-length internodes and NaN diameters"}
+    table = ["| file | triangles | organs | skipped | file MB | read s | MB/s | M triangles/s |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        table.append(f"| {names.get(r['format'], r['format'])} | {int(r['triangles']):,} | "
+                     f"{int(r['organs']):,} | {int(r['skipped']):,} | {number(r['file_mb'])} | "
+                     f"{number(r['read_s'])} | {number(r['mb_per_s'])} | "
+                     f"{number(r['mtriangles_per_s'])} |")
+    return "\n".join(table)
+
+
 def phase_spread_section(build, out, run=True):
     """Runs leaflux_bench_phase_spread (the fitted policy on four generated trees) and plots
     its Fig. 8 slices into examples/report/; returns the NIR table for docs/results.md."""
@@ -333,13 +355,15 @@ def main():
                         help="build directory (default: build/release)")
     parser.add_argument("out", nargs="?", default=os.path.join(ROOT, "out", "report"),
                         help="directory of the runs' files (default: out/report)")
-    parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth",
+    parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth,import",
                         help="parts to run (default: all)")
     parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
     parser.add_argument("--scaling-solvers", default="hrc,mc",
                         help="solvers the scaling run measures; the others' rows are kept from OUT_DIR")
     parser.add_argument("--demo", default=os.path.join(ROOT, "out", "demo"),
                         help="growth part: the output of scripts/demo.sh (default: out/demo)")
+    parser.add_argument("--import-largest", default="1000000",
+                        help="import: the largest files' triangle count (default: %(default)s)")
     parser.add_argument("--tables-only", action="store_true",
                         help="rewrite the tables from the CSVs in examples/report/, run nothing")
     args = parser.parse_args()
@@ -368,6 +392,9 @@ def main():
         update(RESULTS, "phase-db", phase_db_section(build, os.path.join(out, "phase"), run))
     if "phase-spread" in parts:
         update(RESULTS, "phase-spread", phase_spread_section(build, os.path.join(out, "phase_spread"), run))
+    if "import" in parts:
+        update(RESULTS, "import", import_section(build, os.path.join(out, "import"), run,
+                                                 args.import_largest))
     print(f"sections {args.only} rewritten in docs/results.md"
           f"{' and the summary in README.md' if 'error' in parts else ''}; files in {REPORT}")
 

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Time and peak memory against scene size, each solver at one setting, a fresh process
 per run (peak memory is the process's): one generated tree of 1k to 10⁶ leaves, and
 plantations of 1 to 233 trees of 1,000 leaves. Fits the growth exponent of time and

@@ -1,13 +1,13 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Compares per-leaf results of two solvers: `compare.py REFERENCE.csv OTHER.csv`.
 Prints, per band, the L2 error in % of the reference maximum (Soler 2003, Fig. 14), the
 mean and 95th-percentile relative errors over lit leaves (5 % of the brightest or more),
 and the mean signed error of each fifth of the leaves from the darkest to the brightest
 (in % of the maximum): a solver that spreads light too evenly is high in the first fifths
 and low in the last."""
+import argparse
 import csv
 import math
-import sys
 
 LIT = 0.05
 
@@ -42,9 +42,11 @@ def bias_by_fifth(reference, value, band):
 
 
 def main():
-    if len(sys.argv) != 3:
-        sys.exit(__doc__)
-    reference, value = load(sys.argv[1]), load(sys.argv[2])
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split()))
+    parser.add_argument("reference", help="per-leaf CSV of the reference (leaflux solve --out)")
+    parser.add_argument("other", help="per-leaf CSV of the solver compared with it")
+    args = parser.parse_args()
+    reference, value = load(args.reference), load(args.other)
     for band in sorted({k[1] for k in reference}):
         l2, mean, p95 = errors(reference, value, band)
         print(f"{band}: L2 {l2:.2f} % of max, mean relative {mean:.2f} %, 95th percentile {p95:.2f} %")

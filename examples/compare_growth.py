@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Compares two leaflux-grow runs of one scenario grown under other light (paper Fig. 15
 and 19): per cycle, the structural distance between the plants, and each run's solve time
 and daemon memory.
@@ -12,6 +12,7 @@ plants sharing no organ.
 Usage: compare_growth.py RUN_A LABEL_A RUN_B LABEL_B OUT_PREFIX
 Writes OUT_PREFIX.csv and OUT_PREFIX.png.
 """
+import argparse
 import csv
 import os
 import sys
@@ -43,9 +44,15 @@ def distance(a, b):
 
 
 def main():
-    if len(sys.argv) != 6:
-        sys.exit(__doc__)
-    run_a, label_a, run_b, label_b, prefix = sys.argv[1:]
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
+    parser.add_argument("run_a", help="the first run's folder (leaflux-grow --out)")
+    parser.add_argument("label_a", help="its label in the plot")
+    parser.add_argument("run_b", help="the second run's folder")
+    parser.add_argument("label_b", help="its label")
+    parser.add_argument("out_prefix", help="writes OUT_PREFIX.csv and OUT_PREFIX.png")
+    args = parser.parse_args()
+    run_a, label_a, run_b, label_b, prefix = (args.run_a, args.label_a, args.run_b, args.label_b,
+                                              args.out_prefix)
     pa, pb, ca, cb = phytomers(run_a), phytomers(run_b), cycles(run_a), cycles(run_b)
     rows = []
     for c in sorted(pa.keys() & pb.keys()):

@@ -2,9 +2,13 @@
 """Coupling a foreign growth model to leafluxd: a rosette written in a few lines of Python
 sends its own deltas and grows from the light it gets back.
 
-Each cycle the rosette makes a new leaf (a flat blade at the golden angle, raised 20°) and
-every leaf grows in proportion to the PAR it absorbed: only the new leaf is added and
-only the leaves that grew are updated (their frame's scale changes).
+Each cycle (a day) the rosette makes a new leaf (a flat blade at the golden angle, raised
+20°). What the plant makes from the PAR it absorbed (radiation use efficiency) goes, a
+share of it, to its leaves, which expand towards their final size as a lettuce's do: each
+leaf asks what its logistic expansion would take, and gets it in full when the plant makes
+enough, a share of it when not. Only the new leaf is added and only the leaves that grew
+are updated (their frame's scale changes). Twelve leaves make a rosette of about 0.06 m²
+and 4 g of dry matter.
 
 A daemon that restarts, or a cycle that goes unanswered, costs nothing but time: the
 script keeps the nodes the daemon has lit and hands them back (Client.cycle's `resync`).
@@ -17,7 +21,12 @@ import math
 
 from leaflux_client import Client, LocalDaemon, band_light, frame, pb
 
-RUE_G_PER_MJ, LIGHT_HOURS, SLA_M2_PER_G = 2.5, 8.0, 0.03
+# Radiation use efficiency (g of dry matter per MJ of PAR absorbed), light hours a day,
+# specific leaf area (m² of leaf per g), the share of dry matter the leaves get (the rest:
+# roots and stem), a leaf's area when it appears and when grown (m²), and its relative
+# expansion rate while small (per day): lettuce-like values.
+RUE_G_PER_MJ, LIGHT_HOURS, SLA_M2_PER_G, LEAF_SHARE = 2.5, 8.0, 0.03, 0.5
+NEW_LEAF_M2, FINAL_LEAF_M2, EXPANSION_PER_DAY = 0.0005, 0.012, 0.45
 
 
 def scene():
@@ -74,7 +83,7 @@ def grow(client, cycles, settings, csv=None):
     rows = open(csv, "w") if csv else None
     biomass = 0.0
     for number in range(1, cycles + 1):
-        areas.append(0.002)  # a new leaf each cycle
+        areas.append(NEW_LEAF_M2)  # a new leaf each cycle
         new = [leaf_node(len(areas) - 1, areas[-1])]
         result = client.cycle(session, number, added=new, updated=changed, bands=["PAR"],
                               resync=as_before)
@@ -84,12 +93,16 @@ def grow(client, cycles, settings, csv=None):
         total = sum(absorbed.values())
         produced = RUE_G_PER_MJ * total * LIGHT_HOURS * 3600 * 1e-6
         biomass += produced
-        # The new biomass goes to the leaves in proportion to what each absorbed.
+        # Each leaf's logistic expansion is its demand; the leaves' share of what the plant
+        # made is the supply, shared in proportion to the demands when it falls short.
+        demand = [EXPANSION_PER_DAY * a * (1 - a / FINAL_LEAF_M2) for a in areas]
+        supply = SLA_M2_PER_G * LEAF_SHARE * produced
+        served = min(1.0, supply / sum(demand)) if sum(demand) > 0 else 0.0
         changed = []
-        for node, watts in absorbed.items():
-            if watts > 0:
-                areas[node - 100] += SLA_M2_PER_G * produced * watts / total
-                changed.append(leaf_node(node - 100, areas[node - 100]))
+        for i, wanted in enumerate(demand):
+            if wanted * served > 1e-7:
+                areas[i] += wanted * served
+                changed.append(leaf_node(i, areas[i]))
         print(f"{number:>5} {len(areas):>6} {sum(areas):>8.4f} {total:>10.3f} {biomass:>9.3f} "
               f"{len(new) + len(changed):>5}", flush=True)
         if rows:

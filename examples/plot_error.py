@@ -1,11 +1,11 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Plots a `leaflux bench error` CSV: error against wall time (log–log), one panel per band,
 one line per solver, the reference's own standard error drawn as a floor.
 
 Usage: plot_error.py ERROR.csv OUT.png
 """
+import argparse
 import csv
-import sys
 
 import matplotlib
 
@@ -16,9 +16,11 @@ STYLE = {"mc": ("o", "tab:blue"), "hrc": ("s", "tab:orange"), "direct": ("^", "t
 
 
 def main():
-    if len(sys.argv) != 3:
-        sys.exit(__doc__)
-    rows = list(csv.DictReader(open(sys.argv[1])))
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
+    parser.add_argument("csv", help="the CSV of leaflux bench error")
+    parser.add_argument("png", help="the plot to write")
+    args = parser.parse_args()
+    rows = list(csv.DictReader(open(args.csv)))
     scene = rows[0]["scene"]
     bands = list(dict.fromkeys(r["band"] for r in rows))
     fig, axes = plt.subplots(1, len(bands), figsize=(5.5 * len(bands), 4.2), squeeze=False)
@@ -45,8 +47,8 @@ def main():
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(sys.argv[2], dpi=100)
-    print(f"wrote {sys.argv[2]}")
+    fig.savefig(args.png, dpi=100)
+    print(f"wrote {args.png}")
 
 
 if __name__ == "__main__":

@@ -1,10 +1,10 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Plots a leaflux-grow run (its cycles.csv): leaves, leaf area, biomass and absorbed PAR
 per cycle, and the solve time. Usage: plot_growth.py RUN_DIR LABEL [OTHER_RUN_DIR LABEL ...]
 Writes RUN_DIR/growth.png."""
+import argparse
 import csv
 import os
-import sys
 
 import matplotlib
 
@@ -37,6 +37,10 @@ def main(*pairs):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) < 3 or len(sys.argv) % 2 != 1:
-        sys.exit(__doc__)
-    main(*sys.argv[1:])
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split()))
+    parser.add_argument("runs", nargs="+", metavar="RUN_DIR LABEL",
+                        help="a leaflux-grow run's folder and its label, one pair or more")
+    args = parser.parse_args()
+    if len(args.runs) % 2:
+        parser.error("give each run's folder with its label: RUN_DIR LABEL [RUN_DIR LABEL ...]")
+    main(*args.runs)

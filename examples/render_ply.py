@@ -1,9 +1,9 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Renders a leaflux PLY (from `leaflux solve --ply` or `leaflux-grow`) to a PNG: a side and
 a top view, each triangle coloured by its irradiance, both sides summed. Faces whose light
 is negative (walls, ground, lamps written by leaflux-grow) are drawn as grey glass in the
 side view only."""
-import sys
+import argparse
 
 import matplotlib
 
@@ -75,6 +75,9 @@ def main(ply, png, title=None):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) not in (3, 4):
-        sys.exit("usage: render_ply.py IN.ply OUT.png [TITLE]")
-    main(*sys.argv[1:])
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split()))
+    parser.add_argument("ply", help="a PLY of leaflux solve --ply or leaflux-grow")
+    parser.add_argument("png", help="the picture to write")
+    parser.add_argument("title", nargs="?", help="its title (default: none)")
+    args = parser.parse_args()
+    main(args.ply, args.png, args.title)

@@ -7,10 +7,12 @@
 #include <sstream>
 
 #include "growth_stub/run.h"
+#include "server/cli_checks.h"
 
 int main(int argc, char** argv) {
     using namespace leaflux;
     CLI::App app{"leaflux-grow: the reference growth model, a client of leafluxd"};
+    app.option_defaults()->always_capture_default();  // --help shows every default
     std::string scenarioPath, endpoint = "tcp://127.0.0.1:5555", curveKeyFile, solver, pictures;
     grow::RunOptions options;
     int cycles = 0;
@@ -21,30 +23,41 @@ int main(int argc, char** argv) {
     app.add_option("--scenario", scenarioPath, "Scenario file (growth_stub/scenarios/*.txtpb)")
         ->required()
         ->check(CLI::ExistingFile);
-    app.add_option("--cycles", cycles, "Growth cycles (default: the scenario's)")
-        ->check(CLI::Range(1, 100000));
+    app.add_option("--cycles", cycles, "Growth cycles (0: the scenario's, else 25)")
+        ->transform(WholeNumber())
+        ->check(CLI::Range(0, 100000));
     app.add_option("--out", options.outDir,
                    "Output folder: cycles.csv, plants.csv, phytomers.csv (organ masses by "
                    "topological address), cycle<N>.ply");
-    app.add_option("--ply-cycles", pictures, "Cycles whose PLY is written, e.g. 2,9,13,17,25");
+    app.add_option("--ply-cycles", pictures,
+                   "Cycles whose PLY is written into --out, as numbers separated by commas, "
+                   "e.g. 2,9,13,17,25");
     app.add_option("--endpoint", endpoint, "leafluxd's address");
     app.add_option("--curve-server-key", curveKeyFile,
                    "File with leafluxd's CurveZMQ public key (when it has one)")
         ->check(CLI::ExistingFile);
-    app.add_option("--solver", solver, "Override the scenario's solver: hrc or mc")
+    app.add_option("--solver", solver,
+                   "Override the scenario's solver: hrc or mc (empty: the scenario's)")
         ->check(CLI::IsMember({"hrc", "mc"}));
-    app.add_option("--epsilon", epsilon, "Override the scenario's HRC ε")
-        ->check(CLI::Range(1e-9, 1.0));
-    app.add_option("--samples", samples, "Override the scenario's MC paths per receiver")
-        ->check(CLI::Range(2, 1 << 24));
+    app.add_option("--epsilon", epsilon, "Override the scenario's HRC ε (0: the scenario's)")
+        ->check(CLI::Range(0.0, 1.0));
+    app.add_option("--samples", samples,
+                   "Override the scenario's MC paths per receiver (0: the "
+                   "scenario's)")
+        ->transform(WholeNumber())
+        ->check(CLI::Range(0, 1 << 24));
     app.add_flag("--direct-only", directOnly,
                  "Light straight from the sources only, no scattering (paper Fig. 19)");
     app.add_flag("--branch-light", options.branchLight,
                  "Ask for per-axis light only; each leaf gets its axis's");
-    app.add_option("--spacing", spacing, "Override the stand's spacing within rows (m)")
-        ->check(CLI::PositiveNumber);
-    app.add_option("--row-azimuth", rowAzimuth, "Override the stand's row direction (deg from +y)")
-        ->check(CLI::Range(0.0, 360.0));
+    app.add_option("--spacing", spacing,
+                   "Override the stand's spacing within rows (m; 0: the scenario's); "
+                   "refused for a scenario without a stand")
+        ->check(CLI::NonNegativeNumber);
+    app.add_option("--row-azimuth", rowAzimuth,
+                   "Override the stand's row direction (deg from +y; -1: the scenario's); "
+                   "refused for a scenario without a stand")
+        ->check(CLI::Range(-1.0, 360.0));
     app.add_option("--status-timeout", statusTimeoutS,
                    "Seconds to wait for the daemon's answer to a close")
         ->check(CLI::PositiveNumber)
@@ -64,15 +77,26 @@ int main(int argc, char** argv) {
     try {
         grow::Scenario scenario = grow::LoadScenario(scenarioPath);
         options.cycles = cycles > 0 ? cycles : (scenario.cycles() > 0 ? scenario.cycles() : 25);
-        std::stringstream list(pictures);
-        for (std::string item; std::getline(list, item, ',');)
-            options.plyCycles.insert(std::stoi(item));
+        options.plyCycles = grow::CycleList(pictures, "--ply-cycles");
+        if (!options.plyCycles.empty() && options.outDir.empty())
+            throw std::invalid_argument("--ply-cycles: the pictures need a folder: give --out");
         v1::SolverSettings& settings = *scenario.mutable_settings();
         if (solver == "hrc") settings.set_solver(v1::SOLVER_KIND_HRC);
         if (solver == "mc") settings.set_solver(v1::SOLVER_KIND_MONTE_CARLO);
         if (epsilon > 0.0) settings.set_epsilon(epsilon);
         if (samples > 0) settings.set_samples(samples);
         if (directOnly) settings.set_direct_only(true);
+        // A stand's options on a scenario that places its plants one by one would be ignored.
+        for (const auto& [given, option] : {std::pair{spacing > 0.0, "--spacing"},
+                                            std::pair{rowAzimuth >= 0.0, "--row-azimuth"}}) {
+            if (given && !scenario.has_stand()) {
+                throw std::invalid_argument(
+                    std::string(option) + ": scenario " + scenario.name() +
+                    " has no stand (it places its plants one by one), so there is nothing "
+                    "for " +
+                    option + " to change");
+            }
+        }
         if (spacing > 0.0) scenario.mutable_stand()->set_spacing(spacing);
         if (rowAzimuth >= 0.0) scenario.mutable_stand()->set_row_azimuth_deg(rowAzimuth);
 

@@ -1,5 +1,6 @@
 #include "growth_stub/run.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -137,6 +138,30 @@ Scenario LoadScenario(const std::string& path) {
         throw std::invalid_argument(error->where + ": " + error->what);
     }
     return scenario;
+}
+
+std::set<int> CycleList(const std::string& list, const std::string& option) {
+    std::set<int> cycles;
+    std::size_t begin = 0;
+    while (begin < list.size()) {
+        const std::size_t end = std::min(list.find(',', begin), list.size());
+        const std::string item = list.substr(begin, end - begin);
+        std::size_t used = 0;
+        long value = 0;
+        try {
+            value = std::stol(item, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (item.empty() || used != item.size() || value < 1 || value > 1'000'000) {
+            throw std::invalid_argument(option + ": '" + item +
+                                        "' is not a cycle number; give cycle numbers (1 or " +
+                                        "more) separated by commas, such as 2,9,13");
+        }
+        cycles.insert(static_cast<int>(value));
+        begin = end + 1;
+    }
+    return cycles;
 }
 
 std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,

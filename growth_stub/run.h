@@ -38,6 +38,10 @@ struct CycleRecord {
 std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
                              const RunOptions& options, Client& client);
 
+// Cycle numbers from a list such as "2,9,13" ("" is none); anything else is refused with
+// std::invalid_argument, a sentence naming `option` and the item.
+std::set<int> CycleList(const std::string& list, const std::string& option);
+
 // Reads a scenario file (protobuf text format); errors name the file, line and column.
 Scenario LoadScenario(const std::string& path);
 

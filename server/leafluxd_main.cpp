@@ -17,6 +17,7 @@
 #include <csignal>
 #include <cstdlib>
 
+#include "server/cli_checks.h"
 #include "server/daemon.h"
 #include "server/executor.h"
 #include "server/transport.h"
@@ -31,6 +32,7 @@ void OnSignal(int) {
 int main(int argc, char** argv) {
     using namespace leaflux;
     CLI::App app{"leafluxd: the leaflux lighting daemon (ZeroMQ + protobuf, leaflux.v1)"};
+    app.option_defaults()->always_capture_default();  // --help shows every default
     std::string bind = "tcp://127.0.0.1:5555", level = "info", logFile;
     DaemonLimits limits;
     TransportLimits transport;
@@ -48,23 +50,28 @@ int main(int argc, char** argv) {
                    "Also append the log to this file (every request with its timing at info)");
     app.add_option("--solver-threads", limits.solverThreads,
                    "Cores one solve may use (0: all); a session asking fewer gets fewer")
+        ->transform(WholeNumber())
         ->check(CLI::Range(0, 1024));
     app.add_option("--max-sessions", limits.maxSessions, "Sessions served at once")
+        ->transform(WholeNumber())
         ->check(CLI::Range(1, 100000))
         ->capture_default_str();
     app.add_option("--max-nodes", limits.scene.maxNodes,
                    "Nodes a session may hold; an OpenSession, Resync or cycle beyond is refused "
                    "with ERROR_CODE_TOO_LARGE")
+        ->transform(WholeNumber())
         ->check(CLI::Range(1, 1'000'000'000))
         ->capture_default_str();
     app.add_option("--max-suns", limits.scene.maxSuns,
                    "Suns a scene or a cycle may hold, sun period steps included (each is a "
                    "light source every solve traces)")
+        ->transform(WholeNumber())
         ->check(CLI::Range(1, 1'000'000))
         ->capture_default_str();
     app.add_option("--workers", workers,
                    "Requests handled at once (different sessions solve in parallel; Status is "
                    "answered apart, never behind a solve)")
+        ->transform(WholeNumber())
         ->check(CLI::Range(1, 256))
         ->capture_default_str();
     app.add_option("--grace-seconds", graceSeconds,

@@ -2,6 +2,7 @@
 
 #include <google/protobuf/text_format.h>
 #include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
 
 #include <cmath>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "server/scene_structures.h"
 #include "server/text_format.h"
 #include "solver/io/importers.h"
+#include "solver/scene/light_units.h"
 #include "solver/util/error.h"
 
 namespace leaflux {
@@ -171,6 +173,15 @@ v1::NodeType TypeToProto(NodeType type) {
     return v1::NODE_TYPE_OTHER;
 }
 
+namespace {
+
+// Source values that are valid but look mistaken (solver/scene/light_units.h): the log's.
+void LogWarnings(const std::vector<std::string>& warnings) {
+    for (const std::string& warning : warnings) spdlog::warn("{}", warning);
+}
+
+}  // namespace
+
 Sun SunFromProto(const Scene& scene, const v1::Sun& in, const std::string& field) {
     Sun sun;
     if (in.has_solar()) {
@@ -198,6 +209,7 @@ Sun SunFromProto(const Scene& scene, const v1::Sun& in, const std::string& field
     }
     sun.normalIrradianceWm2 = PerBand(scene, in.normal_irradiance(), field + ".normal_irradiance");
     sun.angularRadiusRad = glm::radians(in.angular_radius_deg());
+    LogWarnings(SunWarnings(scene, sun, field));
     return sun;
 }
 
@@ -242,9 +254,11 @@ void ReadSources(const v1::Scene& message, Scene& scene, const std::filesystem::
     for (int i = 0; i < message.sun_periods_size(); ++i) {
         const v1::SunPeriod& p = message.sun_periods(i);
         const std::string field = "sun_periods[" + std::to_string(i) + "]";
-        const auto suns = SunPositionsOverPeriod(
-            p.latitude_deg(), p.day_of_year(), p.start_h(), p.end_h(), p.step_h(),
-            PerBand(scene, p.normal_irradiance(), field + ".normal_irradiance"));
+        const std::vector<double> normalIrradianceWm2 =
+            PerBand(scene, p.normal_irradiance(), field + ".normal_irradiance");
+        LogWarnings(IrradianceWarnings(scene, normalIrradianceWm2, field + ".normal_irradiance"));
+        const auto suns = SunPositionsOverPeriod(p.latitude_deg(), p.day_of_year(), p.start_h(),
+                                                 p.end_h(), p.step_h(), normalIrradianceWm2);
         scene.sources.suns.insert(scene.sources.suns.end(), suns.begin(), suns.end());
     }
     if (message.has_sky()) {
@@ -254,6 +268,8 @@ void ReadSources(const v1::Scene& message, Scene& scene, const std::filesystem::
         sky.horizontalIrradianceWm2 =
             PerBand(scene, message.sky().horizontal_irradiance(), "sky.horizontal_irradiance");
         sky.discretization = DiscretizationFromProto(message.sky().discretization());
+        LogWarnings(
+            IrradianceWarnings(scene, sky.horizontalIrradianceWm2, "sky.horizontal_irradiance"));
         scene.sources.skies.push_back(std::move(sky));
     }
     for (int i = 0; i < message.emitters_size(); ++i) {
@@ -366,7 +382,8 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
         if (!bandNames.insert(band.name()).second) {
             Fail(ErrorCode::kAlreadyExists, "bands[" + band.name() + "]", "is declared twice");
         }
-        scene.bands.push_back({band.name(), band.wavelength_min_nm(), band.wavelength_max_nm()});
+        scene.bands.push_back({band.name(), band.wavelength_min_nm(), band.wavelength_max_nm(),
+                               band.photon_umol_per_j()});
     }
     for (const v1::Optics& optics : message.optics()) {
         Optics o;
@@ -417,6 +434,7 @@ v1::Scene ToProto(const Scene& scene, SceneWriting writing) {
         b->set_name(band.name);
         b->set_wavelength_min_nm(band.wavelengthMinNm);
         b->set_wavelength_max_nm(band.wavelengthMaxNm);
+        b->set_photon_umol_per_j(band.photonUmolPerJ);
     }
     for (const Optics& optics : scene.optics) {
         v1::Optics* o = message.add_optics();

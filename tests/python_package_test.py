@@ -196,6 +196,20 @@ def test_csv_round_trip():
     assert back.structures == cycle.structures
 
 
+def test_photon_units():
+    from leaflux import DAYLIGHT_PAR_UMOL_PER_J, pb, photon_umol_per_j
+    assert DAYLIGHT_PAR_UMOL_PER_J == 4.57
+    assert photon_umol_per_j(pb.Band(name="PAR")) == 4.57
+    assert photon_umol_per_j(pb.Band(name="visible", wavelength_min_nm=400,
+                                     wavelength_max_nm=700)) == 4.57
+    assert photon_umol_per_j(pb.Band(name="red", photon_umol_per_j=5.52)) == 5.52
+    assert photon_umol_per_j(pb.Band(name="NIR", wavelength_min_nm=700,
+                                     wavelength_max_nm=2500)) is None
+    # The top leaf under the 400 W/m² sun: 1,828 µmol m⁻² s⁻¹.
+    top = light().organ(10).band("PAR")
+    assert abs(top.irradiance_upper_wm2 * photon_umol_per_j(pb.Band(name="PAR")) - 1828) < 20
+
+
 def test_dataframe():
     try:
         import pandas  # noqa: F401

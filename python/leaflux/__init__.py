@@ -38,12 +38,13 @@ from .errors import (ERROR_CLASSES, AlreadyExists, DaemonError, DaemonStartError
                      TooLarge, UnknownSession, Unsupported)
 from .results import (CSV_COLUMNS, BandLight, CycleLight, EnergyBalance, OrganLight,  # noqa: E402
                       SolveStatistics, StructureLight, Vector)
-from .scene import band_light, frame, read_scene  # noqa: E402
+from .scene import (DAYLIGHT_PAR_UMOL_PER_J, band_light, frame, photon_umol_per_j,  # noqa: E402
+                    read_scene)
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "pb", "leaflux_pb2", "policy_pb2", "Client", "Timeouts", "DEFAULT_ENDPOINT",
+    "pb", "leaflux_pb2", "policy_pb2", "photon_umol_per_j", "DAYLIGHT_PAR_UMOL_PER_J", "Client", "Timeouts", "DEFAULT_ENDPOINT",
     "LocalDaemon", "find_leafluxd", "LeafluxError", "DaemonError", "RequestTimeout",
     "DaemonStartError", "InvalidArgument", "NotFound", "AlreadyExists", "Degenerate",
     "ParentCycle", "ParseError", "FileError", "Unsupported", "UnknownSession", "TooLarge",

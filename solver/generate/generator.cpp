@@ -331,6 +331,7 @@ void AddPlantation(Scene& scene, const PlantationParameters& parameters,
         parameters.trees > 0 ? parameters.trees : parameters.rows * parameters.columns;
     for (int r = 0, placed = 0; r < parameters.rows; ++r) {
         for (int c = 0; c < parameters.columns && placed < trees; ++c, ++placed) {
+            if (parameters.progress) parameters.progress(static_cast<double>(placed) / trees);
             const double x = (c - 0.5 * (parameters.columns - 1)) * parameters.columnSpacingM +
                              parameters.jitterM * (2.0 * jitter.Uniform() - 1.0);
             const double y = (r - 0.5 * (parameters.rows - 1)) * parameters.rowSpacingM +
@@ -353,6 +354,7 @@ void AddPlantation(Scene& scene, const PlantationParameters& parameters,
             if (parameters.tree.copies) prototypes.emplace_back(begin, scene.nodes.size());
         }
     }
+    if (parameters.progress) parameters.progress(1.0);
     if (groundOptics.empty()) return;
     const glm::dvec3 a = frame.At({-1, -1, 0}), b = frame.At({1, -1, 0}), c = frame.At({1, 1, 0}),
                      d = frame.At({-1, 1, 0});

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,8 @@ struct PlantationParameters {
     // With tree.copies: the trees are exact copies of this many prototype trees (tree i of
     // prototype i mod prototypes), each copy turned about z by a random azimuth.
     int prototypes = 4;
+    // Called with the fraction of the trees placed (0 to 1), when set: a progress bar.
+    std::function<void(double)> progress;
 };
 
 // rows × columns trees (each seeded from the tree seed and its position; with tree.copies,

@@ -2,7 +2,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
+
+#include "solver/scene/light_units.h"
 
 namespace leaflux {
 std::string Number(double value) {
@@ -20,7 +23,9 @@ std::string Quoted(const std::string& text) {
     return quoted + "\"";
 }
 
-void WriteLight(std::ostream& out, const BandLight& light) {
+// `photons`: the band's µmol per J (solver/scene/light_units.h); none leaves the photon
+// columns empty.
+void WriteLight(std::ostream& out, const BandLight& light, std::optional<double> photons) {
     const glm::dvec3 v = light.LightVector();
     // NaN: not solved (a structure solved whole), an empty cell.
     const auto irradiance = [](double value) { return std::isnan(value) ? "" : Number(value); };
@@ -32,12 +37,22 @@ void WriteLight(std::ostream& out, const BandLight& light) {
     } else {
         out << ',';
     }
+    out << ',';
+    if (photons) {
+        out << irradiance(*photons * light.irradianceUpperWm2) << ','
+            << irradiance(*photons * light.irradianceLowerWm2) << ','
+            << Number(*photons * light.absorbedW);
+    } else {
+        out << ",,";
+    }
     out << '\n';
 }
 
+// The photon columns follow the W columns, so that readers by position keep theirs.
 constexpr const char* kLightColumns =
     "irradiance_upper_wm2,irradiance_lower_wm2,absorbed_w,light_x,light_y,light_z,"
-    "stderr_upper_wm2,stderr_lower_wm2\n";
+    "stderr_upper_wm2,stderr_lower_wm2,photon_irradiance_upper_umol_m2_s,"
+    "photon_irradiance_lower_umol_m2_s,absorbed_umol_s\n";
 
 }  // namespace
 
@@ -49,7 +64,7 @@ void WriteLeafCsv(std::ostream& out, const Scene& scene, const FlatScene& flat,
         for (std::size_t b = 0; b < scene.bands.size(); ++b) {
             out << Quoted(flat.receivers[r].name) << ',' << Quoted(scene.bands[b].name) << ','
                 << Number(flat.receivers[r].areaM2) << ',';
-            WriteLight(out, solution.light[r][b]);
+            WriteLight(out, solution.light[r][b], PhotonUmolPerJ(scene.bands[b]));
         }
     }
 }
@@ -62,7 +77,7 @@ void WriteStructureCsv(std::ostream& out, const Scene& scene,
             out << s.node << ',' << Quoted(s.name) << ',' << NodeTypeName(s.type) << ','
                 << s.organCount << ',' << Quoted(scene.bands[b].name) << ',' << Number(s.areaM2)
                 << ',';
-            WriteLight(out, s.bands[b]);
+            WriteLight(out, s.bands[b], PhotonUmolPerJ(scene.bands[b]));
         }
     }
 }
@@ -104,8 +119,12 @@ std::string Summary(const std::string& solver, const Scene& scene, const FlatSce
     for (std::size_t b = 0; b < solution.balance.size(); ++b) {
         const EnergyBalance& e = solution.balance[b];
         text << "; " << scene.bands[b].name << ": incident " << Number(e.incidentW)
-             << " W, absorbed " << Number(e.absorbedW) << " W, escaped " << Number(e.escapedW)
-             << " W, residual " << Number(100.0 * e.RelativeResidual()) << " %";
+             << " W, absorbed " << Number(e.absorbedW) << " W";
+        if (const auto photons = PhotonUmolPerJ(scene.bands[b])) {
+            text << " (" << Number(*photons * e.absorbedW) << " umol/s)";
+        }
+        text << ", escaped " << Number(e.escapedW) << " W, residual "
+             << Number(100.0 * e.RelativeResidual()) << " %";
         if (e.stderrW >= 0.0 && e.incidentW > 0.0) {
             text << " +- " << Number(100.0 * e.stderrW / e.incidentW) << " %";
         }

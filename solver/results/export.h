@@ -14,8 +14,10 @@ std::string Number(double value);
 
 // One row per receiver and band, columns:
 // organ,band,area_m2,irradiance_upper_wm2,irradiance_lower_wm2,absorbed_w,
-// light_x,light_y,light_z,stderr_upper_wm2,stderr_lower_wm2
-// (stderr columns empty when the solver gives none).
+// light_x,light_y,light_z,stderr_upper_wm2,stderr_lower_wm2,
+// photon_irradiance_upper_umol_m2_s,photon_irradiance_lower_umol_m2_s,absorbed_umol_s
+// (stderr columns empty when the solver gives none; photon columns, µmol m⁻² s⁻¹ and
+// µmol s⁻¹, the W columns times the band's PhotonUmolPerJ, empty for a band with none).
 void WriteLeafCsv(std::ostream& out, const Scene& scene, const FlatScene& flat,
                   const Solution& solution);
 
@@ -28,7 +30,8 @@ void WriteStructureCsv(std::ostream& out, const Scene& scene,
 void WritePly(std::ostream& out, const FlatScene& flat, const Solution& solution, int band);
 
 // "<solver>: <receivers> receivers × <bands> bands in <t> s (cpu <c> s), peak <m> MiB,
-//  <rays> rays; <band>: incident … W, absorbed … W, escaped … W, residual …%".
+//  <rays> rays; <band>: incident … W, absorbed … W (… umol/s, for a band with a photon
+//  factor), escaped … W, residual …%".
 std::string Summary(const std::string& solver, const Scene& scene, const FlatScene& flat,
                     const Solution& solution);
 

@@ -8,6 +8,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "solver/scene/light_units.h"
 #include "solver/util/error.h"
 
 namespace leaflux {
@@ -293,6 +294,14 @@ void Scene::Validate() const {
         Require(!band.name.empty(), ErrorCode::kInvalidArgument, "bands.name", "is empty");
         Require(bandNames.insert(band.name).second, ErrorCode::kAlreadyExists,
                 "bands[" + band.name + "]", "is declared twice");
+        char got[32];
+        std::snprintf(got, sizeof got, "%g", band.photonUmolPerJ);
+        Require(std::isfinite(band.photonUmolPerJ) && band.photonUmolPerJ >= 0.0 &&
+                    band.photonUmolPerJ <= kMaxPhotonUmolPerJ,
+                ErrorCode::kInvalidArgument, "bands[" + band.name + "].photon_umol_per_j",
+                std::string("must be 0 (not given) or the band's photons per joule, at most "
+                            "1000 µmol/J (daylight PAR: 4.57), got ") +
+                    got);
     }
     ValidateOptics(*this);
     std::set<std::string> names;

@@ -32,6 +32,9 @@ struct Band {
     std::string name;
     double wavelengthMinNm = 0.0;  // 0 when unknown
     double wavelengthMaxNm = 0.0;
+    // Photons per joule (µmol J⁻¹) as the scene gives it; 0: not given (PhotonUmolPerJ,
+    // solver/scene/light_units.h, says what the band then has).
+    double photonUmolPerJ = 0.0;
 };
 
 // A triangle mesh in its owner's local frame (metres). The upper side of a triangle is the

@@ -3,13 +3,14 @@
 // or solved again when it asks other outputs) and the latency of cycles of a plant growing to
 // 1,000 leaves (HRC, ε = 1e-4, 3e-4 and 1e-3) and 10,000 leaves (ε = 1e-4 and 3e-4), one
 // tenth of the plant added per cycle.
-// Run: build/release/tests/leaflux_bench_daemon [out.csv]
+// Run: build/release/tests/leaflux_bench_daemon [out.csv, default out/bench/daemon_bench.csv]
 #include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <thread>
 #include <utility>
@@ -157,7 +158,9 @@ int main(int argc, char** argv) {
         unchanged(false, 1, "empty_resolve");
         unchanged(false, kRepeats, "empty_nothing");
     }
-    const char* path = argc > 1 ? argv[1] : "daemon_bench.csv";
+    const char* path = argc > 1 ? argv[1] : "out/bench/daemon_bench.csv";
+    if (const auto folder = std::filesystem::path(path).parent_path(); !folder.empty())
+        std::filesystem::create_directories(folder);  // out/ from the checkout root
     std::ofstream csv(path);
     csv << "what,leaves,epsilon,cycle,organs,round_trip_ms,solve_ms,overhead_ms\n";
     std::printf("%-14s %7s %8s %6s %7s %14s %10s %12s\n", "what", "leaves", "epsilon", "cycle",

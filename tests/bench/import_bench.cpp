@@ -3,7 +3,8 @@
 // organs). OPF meshes are shared as in AMAPStudio files (a 48-triangle internode cylinder
 // and a 20-triangle leaf in meshBDD, placed by each organ's `mat`); its triangle count is
 // that of the placed organs. Prints a table and writes CSV.
-// Run: build/release/tests/leaflux_bench_import [out.csv] [largest triangle count, 1e6]
+// Run: build/release/tests/leaflux_bench_import [out.csv, default out/bench/import_bench.csv]
+// [largest triangle count, 1e6]
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -267,7 +268,9 @@ int main(int argc, char** argv) {
     }
     std::filesystem::remove_all(dir);
 
-    const char* path = argc > 1 ? argv[1] : "import_bench.csv";
+    const char* path = argc > 1 ? argv[1] : "out/bench/import_bench.csv";
+    if (const auto folder = std::filesystem::path(path).parent_path(); !folder.empty())
+        std::filesystem::create_directories(folder);  // out/ from the checkout root
     std::ofstream csv(path);
     csv << "format,triangles,organs,skipped,file_mb,read_s,cpu_s,mb_per_s,mtriangles_per_s\n";
     std::printf("%-12s %10s %8s %8s %9s %9s %9s %8s %10s\n", "format", "triangles", "organs",

@@ -3,7 +3,7 @@
 // a hit in memory, a hit on disk with a cold LRU (a restarted process), and the file's size.
 // Bi-directional 130² × 2 bands (135 kB of floats) and mono-directional 130 × 2 functions.
 // Prints a table and writes CSV.
-// Run: build/release/tests/leaflux_bench_phase_db [out.csv]
+// Run: build/release/tests/leaflux_bench_phase_db [out.csv, default out/bench/phase_db_bench.csv]
 #include <unistd.h>
 
 #include <chrono>
@@ -82,7 +82,9 @@ Row Measure(PhaseKind kind, int functions, const std::string& directory) {
 
 int main(int argc, char** argv) {
     using namespace leaflux;
-    const char* csvPath = argc > 1 ? argv[1] : "phase_db_bench.csv";
+    const char* csvPath = argc > 1 ? argv[1] : "out/bench/phase_db_bench.csv";
+    if (const auto folder = std::filesystem::path(csvPath).parent_path(); !folder.empty())
+        std::filesystem::create_directories(folder);  // out/ from the checkout root
     char pattern[] = "/tmp/leaflux-phase-db-bench-XXXXXX";
     const std::string directory = ::mkdtemp(pattern);
     std::vector<Row> rows;

@@ -1,9 +1,10 @@
 // Monte Carlo reference cost: a generated 10,000-leaf tree under sun + CIE overcast sky
 // with NIR-like leaves (ρ = τ = 0.45): the paths per leaf, and the time, that reach a
 // median relative standard error of 1 % over lit leaves. Prints a table and writes CSV.
-// Run: build/release/tests/leaflux_bench_reference [out.csv]
+// Run: build/release/tests/leaflux_bench_reference [out.csv, default out/bench/reference_bench.csv]
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 
 #include "solver/generate/generator.h"
@@ -73,7 +74,9 @@ int main(int argc, char** argv) {
     const int target = std::max(256, static_cast<int>(std::ceil(256 * ratio * ratio / 16.0)) * 16);
     runs.push_back(Measure(prepared, target, sun));
 
-    const char* path = argc > 1 ? argv[1] : "reference_bench.csv";
+    const char* path = argc > 1 ? argv[1] : "out/bench/reference_bench.csv";
+    if (const auto folder = std::filesystem::path(path).parent_path(); !folder.empty())
+        std::filesystem::create_directories(folder);  // out/ from the checkout root
     std::ofstream csv(path);
     csv << "scene,leaves,samples_per_leaf,wall_s,cpu_s,median_rel_stderr,lit_leaves,rays,peak_rss_"
            "mib\n";
