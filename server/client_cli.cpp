@@ -12,31 +12,25 @@
 
 #include "server/cli_checks.h"
 #include "server/scene_proto.h"
+#include "solver/results/export.h"
 #include "solver/util/error.h"
 
 namespace leaflux {
 namespace {
 
-std::string Quoted(const std::string& text) {
-    if (text.find_first_of(",\"\n") == std::string::npos) return text;
-    std::string quoted = "\"";
-    for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return quoted + "\"";
-}
-
 // Full precision, as Python's repr reads it back.
-std::string Number(double value) { return fmt::format("{}", value); }
+std::string Repr(double value) { return fmt::format("{}", value); }
 
 void WriteBand(std::ostream& out, const v1::BandLight& b) {
-    out << Quoted(b.band()) << ',' << Number(b.irradiance_upper_wm2()) << ','
-        << Number(b.irradiance_lower_wm2()) << ',' << Number(b.absorbed_w()) << ',';
+    out << CsvQuoted(b.band()) << ',' << Repr(b.irradiance_upper_wm2()) << ','
+        << Repr(b.irradiance_lower_wm2()) << ',' << Repr(b.absorbed_w()) << ',';
     if (b.has_light_vector()) {
-        out << Number(b.light_vector().x()) << ',' << Number(b.light_vector().y()) << ','
-            << Number(b.light_vector().z());
+        out << Repr(b.light_vector().x()) << ',' << Repr(b.light_vector().y()) << ','
+            << Repr(b.light_vector().z());
     } else {
         out << ",,";
     }
-    out << ',' << Number(b.stderr_upper_wm2()) << ',' << Number(b.stderr_lower_wm2()) << '\n';
+    out << ',' << Repr(b.stderr_upper_wm2()) << ',' << Repr(b.stderr_lower_wm2()) << '\n';
 }
 
 v1::Request OpenFromFile(const ClientCommand& command) {
@@ -117,15 +111,15 @@ void WriteCycleCsv(std::ostream& out, const v1::CycleResult& cycle) {
            "stderr_upper_wm2,stderr_lower_wm2\n";
     for (const v1::OrganLight& organ : cycle.organs()) {
         for (const v1::BandLight& b : organ.bands()) {
-            out << cycle.number() << ",organ," << organ.node() << ',' << Quoted(organ.name())
-                << ",,1," << Number(organ.area_m2()) << ',';
+            out << cycle.number() << ",organ," << organ.node() << ',' << CsvQuoted(organ.name())
+                << ",,1," << Repr(organ.area_m2()) << ',';
             WriteBand(out, b);
         }
     }
     for (const v1::StructureLight& s : cycle.structures()) {
         for (const v1::BandLight& b : s.bands()) {
-            out << cycle.number() << ",structure," << s.node() << ',' << Quoted(s.name()) << ','
-                << v1::NodeType_Name(s.type()) << ',' << s.organs() << ',' << Number(s.area_m2())
+            out << cycle.number() << ",structure," << s.node() << ',' << CsvQuoted(s.name()) << ','
+                << v1::NodeType_Name(s.type()) << ',' << s.organs() << ',' << Repr(s.area_m2())
                 << ',';
             WriteBand(out, b);
         }

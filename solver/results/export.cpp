@@ -14,14 +14,14 @@ std::string Number(double value) {
     return buffer;
 }
 
-namespace {
-
-std::string Quoted(const std::string& text) {
+std::string CsvQuoted(const std::string& text) {
     if (text.find_first_of(",\"\n") == std::string::npos) return text;
     std::string quoted = "\"";
     for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
     return quoted + "\"";
 }
+
+namespace {
 
 // `photons`: the band's µmol per J (solver/scene/light_units.h); none leaves the photon
 // columns empty.
@@ -62,7 +62,7 @@ void WriteLeafCsv(std::ostream& out, const Scene& scene, const FlatScene& flat,
     for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
         if (!solution.unsolved.empty() && solution.unsolved[r]) continue;
         for (std::size_t b = 0; b < scene.bands.size(); ++b) {
-            out << Quoted(flat.receivers[r].name) << ',' << Quoted(scene.bands[b].name) << ','
+            out << CsvQuoted(flat.receivers[r].name) << ',' << CsvQuoted(scene.bands[b].name) << ','
                 << Number(flat.receivers[r].areaM2) << ',';
             WriteLight(out, solution.light[r][b], PhotonUmolPerJ(scene.bands[b]));
         }
@@ -74,8 +74,8 @@ void WriteStructureCsv(std::ostream& out, const Scene& scene,
     out << "node,name,type,organs,band,area_m2," << kLightColumns;
     for (const StructureLight& s : structures) {
         for (std::size_t b = 0; b < scene.bands.size(); ++b) {
-            out << s.node << ',' << Quoted(s.name) << ',' << NodeTypeName(s.type) << ','
-                << s.organCount << ',' << Quoted(scene.bands[b].name) << ',' << Number(s.areaM2)
+            out << s.node << ',' << CsvQuoted(s.name) << ',' << NodeTypeName(s.type) << ','
+                << s.organCount << ',' << CsvQuoted(scene.bands[b].name) << ',' << Number(s.areaM2)
                 << ',';
             WriteLight(out, s.bands[b], PhotonUmolPerJ(scene.bands[b]));
         }

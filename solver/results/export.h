@@ -11,6 +11,9 @@ namespace leaflux {
 
 // A number for a CSV or a summary: nine significant digits, no trailing zeros.
 std::string Number(double value);
+// A CSV field: as it is, or in double quotes (quotes doubled) when it holds a comma, a quote
+// or a line break.
+std::string CsvQuoted(const std::string& text);
 
 // One row per receiver and band, columns:
 // organ,band,area_m2,irradiance_upper_wm2,irradiance_lower_wm2,absorbed_w,
