@@ -11,6 +11,7 @@
 #include <iostream>
 #include <optional>
 
+#include "server/progress.h"
 #include "server/scene_proto.h"
 #include "solver/results/accuracy.h"
 #include "solver/results/export.h"
@@ -355,7 +356,9 @@ int RunErrorBench(const ErrorBenchOptions& options) {
     } else {
         spdlog::info("{}: {} leaves; solving the reference at {} paths per receiver", name, leaves,
                      options.referenceSamples);
-        reference = Solve(prepared, referenceSettings);
+        SolverSettings solving = referenceSettings;  // the same key, with a progress bar
+        solving.monteCarlo.progress = ProgressBar("reference");
+        reference = Solve(prepared, solving);
         WriteCachedReference(cached, *reference);
         spdlog::info("reference solved in {:.1f} s, cached in {}", reference->stats.wallSeconds,
                      cached.string());
