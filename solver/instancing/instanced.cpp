@@ -75,7 +75,7 @@ class InstancedSolve {
     void Run() {
         const std::unique_ptr<Level> top = Build(InstanceTree::kTop, glm::dmat4(1.0), nullptr, 0);
         LevelSolution light = Solve(InstanceTree::kTop, *top, {});
-        held_ = std::move(light.surfaces);
+        HoldSurfaces(light.surfaces);
         errorW_ = light.errorW;
         sourceCount_ = light.sourceCount;
         OpenInstances(*top, light);
@@ -117,8 +117,7 @@ class InstancedSolve {
     ShadowView ShadowsOf(std::uint32_t p, const FlatScene& flat) const;
     // The light that arrived on closed instance c of `level`, as the sources of its contents.
     std::vector<DirectionalSource> ArrivedOn(const LevelSolution& light, std::size_t c) const;
-    // The cone of light of bin d holding `normalIrradiance`.
-    DirectionalSource BinCone(int d, std::vector<double> normalIrradiance) const;
+    void HoldSurfaces(const std::vector<LevelSolution::SurfacePatch>& surfaces);
     void OpenInstances(const Level& level, const LevelSolution& light);
     // Whether part q is opened (InstancedOptions::maxDepth, outputLevel).
     bool Opens(std::uint32_t q) const;
@@ -140,8 +139,9 @@ class InstancedSolve {
     std::unordered_map<NodeId, std::uint32_t> organReceiver_;
     std::uint32_t firstOther_ = kNoReceiver;  // the first environment surface or emitter
     std::uint32_t organTriangles_ = 0;        // of the receivers, the organs' first
-    // The top's surfaces as solved, which every opened instance holds (ReceiverKind::kHeld).
-    std::vector<LevelSolution::SurfacePatch> held_;
+    // The top's surfaces as solved, each patch side that sends light an emitter, which
+    // every opened instance holds (ReceiverKind::kHeld); their meshes shared.
+    std::vector<Emitter> held_;
     double errorW_ = 0.0;
     std::size_t sourceCount_ = 0;
     std::mutex statsMutex_;
@@ -159,21 +159,7 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
         local.environment = scene_.environment;
         local.sources = scene_.sources;
     } else {
-        // The top's surfaces, each patch side that sends light an emitter of its own.
-        for (const LevelSolution::SurfacePatch& patch : held_) {
-            for (int side : {kUpper, kLower}) {
-                const std::vector<double>& exitance = side == kUpper ? patch.upper : patch.lower;
-                if (std::none_of(exitance.begin(), exitance.end(),
-                                 [](double e) { return e > 0.0; }))
-                    continue;
-                auto mesh = std::make_shared<Mesh>();
-                mesh->positions = {patch.a, side == kUpper ? patch.b : patch.c,
-                                   side == kUpper ? patch.c : patch.b};
-                mesh->triangles = {{0, 1, 2}};
-                Emitter held{"held surface", std::move(mesh), exitance, "", true};
-                local.sources.emitters.push_back(std::move(held));
-            }
-        }
+        local.sources.emitters = held_;
     }
     local.nodes.reserve(part.nodes.size());
     for (std::size_t i : part.nodes) {
@@ -297,11 +283,19 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     return light;
 }
 
-DirectionalSource InstancedSolve::BinCone(int d, std::vector<double> normalIrradiance) const {
-    DirectionalSource cone{directions_.Direction(d), std::move(normalIrradiance),
-                           1.0 - directions_.HatIntegralSr(d) / (2.0 * std::numbers::pi)};
-    cone.incident = false;  // scattered inside the scene
-    return cone;
+void InstancedSolve::HoldSurfaces(const std::vector<LevelSolution::SurfacePatch>& surfaces) {
+    for (const LevelSolution::SurfacePatch& patch : surfaces) {
+        for (int side : {kUpper, kLower}) {
+            const std::vector<double>& exitance = side == kUpper ? patch.upper : patch.lower;
+            if (std::none_of(exitance.begin(), exitance.end(), [](double e) { return e > 0.0; }))
+                continue;
+            auto mesh = std::make_shared<Mesh>();
+            mesh->positions = {patch.a, side == kUpper ? patch.b : patch.c,
+                               side == kUpper ? patch.c : patch.b};
+            mesh->triangles = {{0, 1, 2}};
+            held_.push_back({"held surface", std::move(mesh), exitance, "", true});
+        }
+    }
 }
 
 std::vector<DirectionalSource> InstancedSolve::ArrivedOn(const LevelSolution& light,
@@ -337,11 +331,12 @@ std::vector<DirectionalSource> InstancedSolve::ArrivedOn(const LevelSolution& li
             for (int k = 0; k < channels; ++k)
                 e[k] = std::max(0.0, e[k] - light.surfaceBins[c][d * channels + k]);
         }
-        if (lit(e)) {
-            DirectionalSource cone = BinCone(d, std::move(e));
-            cone.beyond = false;  // what it met outside, its irradiance holds
-            sources.push_back(std::move(cone));
-        }
+        if (!lit(e)) continue;
+        DirectionalSource cone{directions_.Direction(d), std::move(e),
+                               1.0 - directions_.HatIntegralSr(d) / (2.0 * std::numbers::pi)};
+        cone.beyond = false;    // what it met outside, its irradiance holds
+        cone.incident = false;  // scattered inside the scene
+        sources.push_back(std::move(cone));
     }
     return sources;
 }

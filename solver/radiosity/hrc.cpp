@@ -536,7 +536,7 @@ void SceneSolve::Arrived(LevelSolution& level) const {
         std::copy_n(closedLight_.sources[c], sources_.size(), level.sourceVisibility[c].begin());
     }
     if (!level_.splitSurfaces) return;
-    level.surfaceBins = SurfaceBins();
+    if (closed > 0) level.surfaceBins = SurfaceBins();
     for (std::uint32_t n : traversal_.Leaves()) {
         const HrcNode& node = hierarchy_[n];
         if (!node.patch || model_.HoldsOrgans(n) || model_.Held(n)) continue;
