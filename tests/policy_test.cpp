@@ -33,8 +33,14 @@ std::string PolicyPath(const std::string& name) {
     return std::string(LEAFLUX_SOURCE_DIR) + "/proto/policies/" + name;
 }
 
+// A file of the running test's own (ctest runs tests side by side, each in a process).
+std::string TempPath(const std::string& name) {
+    const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
+    return ::testing::TempDir() + test->test_suite_name() + "." + test->name() + "." + name;
+}
+
 std::string Write(const std::string& name, const std::string& text) {
-    const std::string path = ::testing::TempDir() + name;
+    const std::string path = TempPath(name);
     std::ofstream(path) << text;
     return path;
 }
@@ -124,7 +130,7 @@ TEST(PolicyFile, SyntaxErrorNamesFileLineAndColumn) {
     const std::string text = "species: \"test\"\ninstance_types: [NODE_TYPE_AXIS\n";
     const InputError e = FileError(text);
     EXPECT_EQ(e.Code(), ErrorCode::kParse);
-    EXPECT_EQ(e.Field().rfind(::testing::TempDir() + "bad_policy.txtpb:3:", 0), 0u) << e.Field();
+    EXPECT_EQ(e.Field().rfind(TempPath("bad_policy.txtpb") + ":3:", 0), 0u) << e.Field();
 }
 
 TEST(PolicyFile, MissingFileIsAnIoError) {
