@@ -18,6 +18,13 @@ void TriangleMoments(HrcNode& node) {
                           glm::dot(node.c - node.centroid, node.c - node.centroid);
     node.spread = std::sqrt(second / 12.0);
 }
+
+// A point of weight `area` (never 0, so that every subtree has a centroid), for area
+// centroids summed up the tree.
+glm::dvec4 Moment(const glm::dvec3& centre, double area) {
+    const double weight = std::max(area, std::numeric_limits<double>::min());
+    return glm::dvec4(centre * weight, weight);
+}
 }  // namespace
 
 Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat, std::span<const ClosedNode> closed)
@@ -95,6 +102,7 @@ Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat, std::span<const 
     ofScene_ = std::move(built);
     if (top.empty()) return;
     root_ = top.size() == 1 ? top[0] : Constrain(std::move(top));
+    moments_ = {};
     cumulativeArea_.push_back(0.0);
     Finish(root_);
     orderOf_.assign(flat.triangles.size(), 0);
@@ -119,6 +127,7 @@ std::uint32_t Hierarchy::AddPatch(std::uint32_t triangle) {
     node.triangle = triangle;
     node.receiver = t.receiver;
     nodes_.push_back(node);
+    moments_.push_back(Moment((t.a + t.b + t.c) / 3.0, t.areaM2));
     const auto index = static_cast<std::uint32_t>(nodes_.size() - 1);
     if (patchOf_.empty()) patchOf_.assign(flat_.triangles.size(), kNoNode);
     patchOf_[triangle] = index;
@@ -127,7 +136,12 @@ std::uint32_t Hierarchy::AddPatch(std::uint32_t triangle) {
 
 std::uint32_t Hierarchy::AddCluster(std::vector<std::uint32_t> children) {
     const auto index = static_cast<std::uint32_t>(nodes_.size());
-    for (std::uint32_t child : children) nodes_[child].parent = index;
+    glm::dvec4 moment(0.0);
+    for (std::uint32_t child : children) {
+        nodes_[child].parent = index;
+        moment += moments_[child];
+    }
+    moments_.push_back(moment);
     HrcNode node;
     node.children = std::move(children);
     nodes_.push_back(std::move(node));
@@ -159,6 +173,7 @@ std::uint32_t Hierarchy::AddClosed(std::uint32_t index) {
         node.radius = std::max(node.radius, glm::length(linear * (p - middle)));
     }
     nodes_.push_back(node);
+    moments_.push_back(Moment(node.centre, node.areaM2));
     closedNode_.push_back(static_cast<std::uint32_t>(nodes_.size() - 1));
     return closedNode_.back();
 }
@@ -166,32 +181,27 @@ std::uint32_t Hierarchy::AddClosed(std::uint32_t index) {
 std::uint32_t Hierarchy::Constrain(std::vector<std::uint32_t> children) {
     if (children.size() <= static_cast<std::size_t>(kMaxChildren))
         return AddCluster(std::move(children));
-    // Median split along the widest axis of the children's centres, until each group fits.
-    auto centreOf = [&](std::uint32_t n) {
-        const HrcNode& node = nodes_[n];
-        if (node.patch) return (node.a + node.b + node.c) / 3.0;
-        if (node.closed >= 0) return node.centre;
-        glm::dvec3 sum(0.0);
-        std::vector<std::uint32_t> stack = {n};
-        int count = 0;
-        while (!stack.empty()) {  // mean of the patch centres below: clusters are small here
-            const HrcNode& at = nodes_[stack.back()];
-            stack.pop_back();
-            if (at.patch) {
-                sum += (at.a + at.b + at.c) / 3.0;
-                ++count;
-                if (count > 64) break;
-            }
-            stack.insert(stack.end(), at.children.begin(), at.children.end());
-        }
-        return count ? sum / static_cast<double>(count) : glm::dvec3(0.0);
-    };
+    // Each child at the area centroid of everything under it.
     std::vector<std::pair<glm::dvec3, std::uint32_t>> items;
-    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    items.reserve(children.size());
     for (std::uint32_t child : children) {
-        items.push_back({centreOf(child), child});
-        lo = glm::min(lo, items.back().first);
-        hi = glm::max(hi, items.back().first);
+        const glm::dvec4& moment = moments_[child];
+        items.push_back({glm::dvec3(moment) / moment.w, child});
+    }
+    return Constrain(items.begin(), items.end());
+}
+
+std::uint32_t Hierarchy::Constrain(CentredIterator from, CentredIterator to) {
+    if (to - from <= kMaxChildren) {
+        std::vector<std::uint32_t> children;
+        for (auto it = from; it != to; ++it) children.push_back(it->second);
+        return children.size() == 1 ? children[0] : AddCluster(std::move(children));
+    }
+    // Median split along the widest axis of the children's centres, until each group fits.
+    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    for (auto it = from; it != to; ++it) {
+        lo = glm::min(lo, it->first);
+        hi = glm::max(hi, it->first);
     }
     const glm::dvec3 extent = hi - lo;
     const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0
@@ -199,20 +209,18 @@ std::uint32_t Hierarchy::Constrain(std::vector<std::uint32_t> children) {
                                                                   : 2;
     // Split into kMaxChildren groups of equal size along the axis (one level of an
     // octree-like split), each constrained again.
-    std::sort(items.begin(), items.end(), [axis](const auto& p, const auto& q) {
+    std::sort(from, to, [axis](const auto& p, const auto& q) {
         return p.first[axis] < q.first[axis] ||
                (p.first[axis] == q.first[axis] && p.second < q.second);
     });
+    const std::size_t size = static_cast<std::size_t>(to - from);
+    const std::size_t groupCount = std::max<std::size_t>(
+        2, std::min<std::size_t>(kMaxChildren, (size + kMaxChildren - 1) / kMaxChildren));
     std::vector<std::uint32_t> groups;
-    const std::size_t parts =
-        std::min<std::size_t>(kMaxChildren, (items.size() + kMaxChildren - 1) / kMaxChildren);
-    const std::size_t groupCount = std::max<std::size_t>(2, parts);
     for (std::size_t g = 0; g < groupCount; ++g) {
-        const std::size_t from = items.size() * g / groupCount,
-                          to = items.size() * (g + 1) / groupCount;
-        std::vector<std::uint32_t> group;
-        for (std::size_t i = from; i < to; ++i) group.push_back(items[i].second);
-        groups.push_back(group.size() == 1 ? group[0] : Constrain(std::move(group)));
+        groups.push_back(
+            Constrain(from + static_cast<std::ptrdiff_t>(size * g / groupCount),
+                      from + static_cast<std::ptrdiff_t>(size * (g + 1) / groupCount)));
     }
     return AddCluster(std::move(groups));
 }

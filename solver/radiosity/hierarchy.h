@@ -104,14 +104,18 @@ class Hierarchy {
     std::uint32_t AddPatch(std::uint32_t triangle);
     std::uint32_t AddCluster(std::vector<std::uint32_t> children);
     std::uint32_t AddClosed(std::uint32_t index);
-    // Groups children into at most kMaxChildren subtrees by median splits in space.
+    // Groups children into at most kMaxChildren subtrees by median splits in space of
+    // their area centroids.
     std::uint32_t Constrain(std::vector<std::uint32_t> children);
+    using CentredIterator = std::vector<std::pair<glm::dvec3, std::uint32_t>>::iterator;
+    std::uint32_t Constrain(CentredIterator from, CentredIterator to);
     void Finish(std::uint32_t node);
     // Sets a cluster's `flat` and `normal` from its children's.
     void FindPlane(HrcNode& cluster) const;
 
     const FlatScene& flat_;
     std::vector<HrcNode> nodes_;
+    std::vector<glm::dvec4> moments_;  // while building, by node: Σ area × centroid, Σ area
     std::vector<ClosedNode> closed_;
     std::vector<std::uint32_t> closedNode_;              // by closed instance: its node
     std::unordered_map<NodeId, std::uint32_t> ofScene_;  // NodeOf
