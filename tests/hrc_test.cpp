@@ -9,7 +9,9 @@
 #include "solver/radiosity/form_factor.h"
 #include "solver/results/accuracy.h"
 #include "solver/solve.h"
+#include "solver/util/directions.h"
 #include "solver/util/error.h"
+#include "solver/util/sampling.h"
 #include "tests/scene_builders.h"
 
 namespace leaflux {
@@ -224,6 +226,40 @@ TEST(FormFactor, MeanOverPointsOfAFaceSumsToOneInsideACube) {
     EXPECT_NEAR(weightedSum, 1.0, 1e-9);
 }
 
+// The directions exact links' near rays take (LinkVisibility::BetweenPatches): uniform in a
+// spherical triangle's solid angle, so that a sub-triangle gets its share of the samples,
+// and Ω |n · ω| / π averages to the point's form factor (Lambert's formula).
+TEST(FormFactor, DirectionsUniformInASphericalTriangleAverageToItsFormFactor) {
+    const glm::dvec3 x(0.0), n = glm::normalize(glm::dvec3(0.2, -0.1, 1.0));
+    const glm::dvec3 a(-0.3, -0.2, 0.15), b(0.6, -0.1, 0.4), c(0.1, 0.5, 0.05);
+    const glm::dvec3 ua = glm::normalize(a), ub = glm::normalize(b), uc = glm::normalize(c);
+    const glm::dvec3 um = glm::normalize(0.5 * (ub + uc));  // splits it into a b m and a m c
+    const double solidAngle = SphericalTriangleSolidAngle(ua, ub, uc);
+    const double share = SphericalTriangleSolidAngle(ua, ub, um) / solidAngle;
+    const glm::dvec3 split = glm::cross(ua, um);  // the great circle through a and m
+    const int count = 200000;
+    Random random(11);
+    double sum = 0.0, squares = 0.0;
+    int inFirst = 0;
+    for (int i = 0; i < count; ++i) {
+        const glm::dvec3 omega =
+            UniformSphericalTriangle(ua, ub, uc, random.Uniform(), random.Uniform());
+        ASSERT_NEAR(glm::length(omega), 1.0, 1e-12);
+        const double value = solidAngle * std::abs(glm::dot(n, omega)) / glm::pi<double>();
+        sum += value;
+        squares += value * value;
+        if (glm::dot(split, omega) * glm::dot(split, ub) > 0.0) ++inFirst;
+    }
+    const double mean = sum / count;
+    const double error = std::sqrt((squares / count - mean * mean) / count);
+    const SidedFormFactor f = PointToTriangle(x, n, a, b, c);
+    std::printf("form factor %.6f by directions, %.6f by Lambert's formula\n", mean,
+                f.upper + f.lower);
+    EXPECT_NEAR(mean, f.upper + f.lower, 5.0 * error);
+    EXPECT_NEAR(static_cast<double>(inFirst) / count, share,
+                5.0 * std::sqrt(share * (1.0 - share) / count));
+}
+
 // Hierarchical radiosity does not make form factors sum to one exactly; an excess δ comes
 // back as B = E / (1 − ρ(1 + δ)), so the error grows as 1/(1 − ρ): within 1 % for ρ ≤ 0.9
 // at ε = 1e-6, and for ρ = 0.99 (stiff) a converged, finite answer within 3 %.
@@ -401,6 +437,52 @@ TEST(HrcExposure, SharesOutTheLightAClusterGathersTowardsTheOpenLeaf) {
                     even.light[r][0].irradianceUpperWm2);
         EXPECT_LT(error, 0.5 * evenError - 4.6 * want.stderrUpperWm2);
     }
+}
+
+// Sending, a cluster needs no exposure of its own: a link's rays run from the receiver to
+// points of the sender cluster weighted by what each sends (LinkVisibility::Between), so
+// they meet the cluster's own leaves in the way. Two leaves of one plant (ρ = 0.5 on top,
+// black below, τ = 0), one 10 cm above the other, both lit on top by a sun 30° high; a
+// black sensor 5 m straight above sees the top leaf alone, which sends ρ E sin 30°:
+// E_sensor = ρ E sin 30° F(sensor → top leaf). Counted unshaded, the lower leaf's light
+// would add 0.84 of that. The cluster's intensity is interpolated in its direction set
+// (§4.2.2), each leaf's lobe scaled to integrate to π: at 514 directions it is within
+// 0.3 % of ρ E sin 30° A |cos θ| / π towards the sensor; at the default 34 it is 6.5 %
+// over (a coarser lobe), so the test takes 514.
+TEST(HrcExposure, AClusterSendsOnlyWhatItsOpenLeavesSend) {
+    Scene scene = OneBandScene(
+        {{"top", {0.5, 0.0, 0.0, 0.0}}, {"bottom", Leaf(0.5, 0.0)}, {"black", Leaf(0.0, 0.0)}});
+    Node plant;
+    plant.id = 10;
+    plant.type = NodeType::kPlant;
+    plant.name = "plant";
+    scene.nodes.push_back(plant);
+    scene.nodes.push_back(OrganNode(1, "top", Rectangle(0.2, 0.2, 1.1), "top", 10));
+    scene.nodes.push_back(OrganNode(2, "bottom", Rectangle(0.2, 0.2, 1.0), "bottom", 10));
+    scene.nodes.push_back(OrganNode(3, "sensor", Rectangle(0.2, 0.2, 6.0, true), "black"));
+    scene.sources.suns.push_back(SunAt(30.0, 90.0, 1000.0));
+    scene.Validate();
+    const PreparedScene prepared(scene);
+    SolverSettings settings = HrcSettings(1e-3);
+    settings.hrc.auditLinks = true;
+    settings.hrc.directionLevel = 4;
+    const Solution hrc = Solve(prepared, settings);
+    // The sensor takes the plant's light through a link from the cluster.
+    const auto fromCluster =
+        std::find_if(hrc.linkAudit.begin(), hrc.linkAudit.end(), [](const LinkAudit& audit) {
+            return audit.kind.find("cluster into a plane") != std::string::npos;
+        });
+    ASSERT_NE(fromCluster, hrc.linkAudit.end());
+    ASSERT_EQ(fromCluster->links, 1);
+    // Parallel opposed squares of side a at distance d (Howell's catalogue, C-11).
+    const double x = 0.2 / 4.9, root = std::sqrt(1.0 + x * x);
+    const double form = 2.0 / (kPi * x * x) *
+                        (std::log((1.0 + x * x) * (1.0 + x * x) / (1.0 + 2.0 * x * x)) / 2.0 +
+                         2.0 * x * root * std::atan(x / root) - 2.0 * x * std::atan(x));
+    const double expected = 0.5 * 1000.0 * std::sin(glm::radians(30.0)) * form;
+    const double got = hrc.light[2][0].irradianceUpperWm2;
+    std::printf("sensor: %.5g W/m², closed form %.5g W/m²\n", got, expected);
+    EXPECT_NEAR(got, expected, 0.01 * expected);
 }
 
 // Direct light only: the sun's light arrives, what the leaves scatter does not. The top

@@ -167,7 +167,7 @@ Refiner::Verdict Refiner::JudgePair(std::uint32_t r, std::uint32_t s) const {
     }
     Verdict verdict;
     const double unoccluded = exact ? e.form.upper + e.form.lower : 0.0;
-    const Sight sight = visibility_.Between(r, s, RaySet::kJudging, verdict.rays, unoccluded);
+    const Sight sight = visibility_.Between(r, s, RaySet::kJudging, verdict.rays);
     if (e.Error(sight.spread) > threshold) {
         if (const auto split = SplitChoice(r, s); split != Verdict::kNone) {
             verdict.kind = split;
@@ -221,9 +221,7 @@ void Refiner::SetTransfer(NodeLink& link, const Estimate& e, double v) const {
 // ε = 1e-5, for 1.3 % more rays. `e` is the link's estimate (Estimator::Exact or
 // Estimator::Pair).
 void Refiner::Value(std::uint32_t r, NodeLink& link, const Estimate& e, std::int64_t& rays) const {
-    const double unoccluded = link.exact ? e.form.upper + e.form.lower : 0.0;
-    SetTransfer(link, e,
-                visibility_.Between(r, link.sender, RaySet::kValuing, rays, unoccluded).visibility);
+    SetTransfer(link, e, visibility_.Between(r, link.sender, RaySet::kValuing, rays).visibility);
     link.ownRays = true;
 }
 

@@ -7,7 +7,9 @@
 
 namespace leaflux {
 namespace {
-constexpr double kPi = glm::pi<double>();
+// How large a patch's radius is against its distance where its rays go in directions
+// uniform over it rather than to points uniform on it.
+constexpr double kNear = 0.5;
 
 // The closed instances a ray leaves out: those of its two ends (−1: none).
 struct Exclusion {
@@ -53,8 +55,78 @@ double LinkVisibility::HeldTransmittance(const Hierarchy::Point& p, const glm::d
                : 1.0;
 }
 
-Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
-                              double unoccluded) const {
+Sight LinkVisibility::BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet set,
+                                     std::int64_t& rays) const {
+    Random random(StreamSeed(static_cast<std::uint64_t>(set), r, s));
+    const int count = visibilityRays_;
+    const HrcNode& S = hierarchy_[s];
+    const bool boxes = !occlusion_.TrianglesOnly();
+    const bool held = model_.Held(s);
+    double seen = 0.0, total = 0.0, passed = 0.0;
+    int traced = 0;
+    for (int i = 0; i < count; ++i) {
+        const Hierarchy::Point p =
+            hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
+        const double u = (ShuffledStratum(i, count) + random.Uniform()) / count,
+                     v = random.Uniform();
+        // Each ray weighted by its estimate of π F(x → S): where S is near (its radius
+        // more than kNear of its distance), Ω |n · ω| for a direction uniform in S's solid
+        // angle Ω; farther, A_S |n · ω| |cos θy| / d² to a point uniform on S, that kernel
+        // varying little over it.
+        glm::dvec3 omega;
+        double weight, length;
+        if (S.radius > kNear * glm::length(S.centroid - p.position)) {
+            const glm::dvec3 a = glm::normalize(S.a - p.position),
+                             b = glm::normalize(S.b - p.position),
+                             c = glm::normalize(S.c - p.position);
+            omega = UniformSphericalTriangle(a, b, c, u, v);
+            const double along = glm::dot(omega, S.normal);
+            if (along == 0.0) continue;
+            length = glm::dot(S.a - p.position, S.normal) / along;
+            weight = SphericalTriangleSolidAngle(a, b, c) *
+                     model_.ReceivingWeight(p.triangle, p.normal, omega);
+        } else {
+            const Hierarchy::Point q = hierarchy_.Sample(s, u, v);
+            const glm::dvec3 d = q.position - p.position;
+            length = glm::length(d);
+            if (!(length > 0.0)) continue;
+            omega = d / length;
+            weight = S.areaM2 * model_.ReceivingWeight(p.triangle, p.normal, omega) *
+                     std::abs(glm::dot(q.normal, omega)) / (length * length);
+        }
+        if (!(weight > 0.0) || !(length > 0.0)) continue;
+        // The ray ends short of S's plane by its last 10⁻⁴, and where it comes within 10⁻⁴
+        // of S's radius of that plane: a ray grazing it from a point by its edge (a corner
+        // of a room) would meet S's coplanar neighbours there, by rounding alone.
+        length -= std::max(1e-4 * length, 1e-4 * S.radius / std::abs(glm::dot(omega, S.normal)));
+        ++rays, ++traced;
+        total += weight;
+        if (length <= 0.0) {
+            seen += weight;
+            passed += 1.0;
+            continue;
+        }
+        const RayStart start{p.position, p.triangle};
+        double through;
+        if (!boxes && !held) {  // triangles alone: a ray passes or not
+            through = occlusion_.Triangles().Occluded(start, omega, length) ? 0.0 : 1.0;
+        } else {
+            const std::int32_t ends[2] = {p.closed, -1};
+            through = held ? HeldTransmittance(p, omega, length)
+                           : occlusion_.LocalTransmittance(start, omega, length, Exclusion(ends));
+        }
+        seen += weight * through;
+        passed += through;
+    }
+    Sight sight;
+    sight.spread = VisibilitySpread(traced > 0 ? passed / traced : 1.0, visibilityRays_);
+    sight.visibility = total > 0.0 ? seen / total : 1.0;
+    return sight;
+}
+
+Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set,
+                              std::int64_t& rays) const {
+    if (hierarchy_[r].patch && hierarchy_[s].patch) return BetweenPatches(r, s, set, rays);
     Random random(StreamSeed(static_cast<std::uint64_t>(set), r, s));
     const int count = visibilityRays_;
     const bool fromCluster = !hierarchy_[s].patch;
@@ -66,7 +138,9 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std:
     for (int i = 0; i < count; ++i) {
         const Hierarchy::Point p =
             hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
-        const Hierarchy::Point q = hierarchy_.Sample(s, random.Uniform(), random.Uniform());
+        // Stratified over S as well: a cluster's children each get their share of rays.
+        const Hierarchy::Point q = hierarchy_.Sample(
+            s, (ShuffledStratum(i, count) + random.Uniform()) / count, random.Uniform());
         const glm::dvec3 d = q.position - p.position;
         const double distance = glm::length(d);
         if (distance <= 0.0) continue;
@@ -98,10 +172,7 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std:
     }
     Sight sight;
     sight.spread = VisibilitySpread(traced > 0 ? passed / traced : 1.0, visibilityRays_);
-    if (unoccluded > 0.0) {
-        const double blocked = hierarchy_[s].areaM2 / kPi * (total - visible) / count;
-        sight.visibility = std::clamp(1.0 - blocked / unoccluded, -1.0, 1.0);
-    } else if (totalLight > 0.0) {
+    if (totalLight > 0.0) {
         sight.visibility = visibleLight / totalLight;
     } else {
         sight.visibility = total > 0.0 ? visible / total : 0.0;
@@ -128,7 +199,7 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
             hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
         glm::dvec3 toward = light.toward;
         if (!beam) {
-            const int cell = static_cast<int>((i * 7919L) % count);
+            const int cell = ShuffledStratum(i, count);
             toward = UniformCone(light.toward, light.cosRadius,
                                  (cell % rings + random.Uniform()) / rings,
                                  (cell / rings + random.Uniform()) / ((count + rings - 1) / rings));

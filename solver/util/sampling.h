@@ -3,6 +3,7 @@
 // do not depend on scheduling.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
@@ -91,10 +92,54 @@ inline glm::dvec3 UniformCone(const glm::dvec3& axis, double cosMax, double u, d
     return FromLocal(axis, {r * std::cos(phi), r * std::sin(phi), z});
 }
 
+// Stratum i of `count` in an order unrelated to i (multiplied by a prime modulo count; a
+// permutation for count < 7919): two coordinates stratified over the same samples then do
+// not pair stratum with stratum.
+inline int ShuffledStratum(int i, int count) {
+    return static_cast<int>((static_cast<std::int64_t>(i) * 7919) % count);
+}
+
 // Uniform on a triangle: barycentric weights of a, b, c.
 inline glm::dvec3 UniformTriangle(double u, double v) {
     const double s = std::sqrt(u);
     return {1.0 - s, s * (1.0 - v), s * v};
+}
+
+// Uniform in the solid angle of the spherical triangle of unit vectors a, b, c (Arvo 1995,
+// "Stratified sampling of spherical triangles"): a sub-triangle of area u × its area is
+// cut off at a, and its far edge sampled by v.
+inline glm::dvec3 UniformSphericalTriangle(const glm::dvec3& a, const glm::dvec3& b,
+                                           const glm::dvec3& c, double u, double v) {
+    // The angles at the vertices, between the great circles through them.
+    auto angle = [](const glm::dvec3& at, const glm::dvec3& p, const glm::dvec3& q) {
+        const glm::dvec3 toP = glm::cross(at, p), toQ = glm::cross(at, q);
+        const double lengths = glm::length(toP) * glm::length(toQ);
+        return lengths > 0.0 ? std::acos(std::clamp(glm::dot(toP, toQ) / lengths, -1.0, 1.0)) : 0.0;
+    };
+    const double alpha = angle(a, b, c);
+    const double area = alpha + angle(b, c, a) + angle(c, a, b) - glm::pi<double>();
+    const double part = u * area;
+    const double s = std::sin(part - alpha), t = std::cos(part - alpha);
+    const double sinAlpha = std::sin(alpha), cosAlpha = std::cos(alpha);
+    const double p = t - cosAlpha, q = s + sinAlpha * glm::dot(a, b);
+    const double denominator = (q * s + p * t) * sinAlpha;
+    const double cosine =
+        denominator != 0.0 ? std::clamp(((q * t - p * s) * cosAlpha - q) / denominator, -1.0, 1.0)
+                           : 1.0;
+    // The sub-triangle's third vertex, on the arc from a to c.
+    const glm::dvec3 awayFromA = c - glm::dot(c, a) * a;
+    const double awayLength = glm::length(awayFromA);
+    const glm::dvec3 cut =
+        awayLength > 0.0
+            ? cosine * a + std::sqrt(std::max(0.0, 1.0 - cosine * cosine)) * awayFromA / awayLength
+            : a;
+    // Along the arc from b to that vertex.
+    const double z = 1.0 - v * (1.0 - glm::dot(cut, b));
+    const glm::dvec3 awayFromB = cut - glm::dot(cut, b) * b;
+    const double awayFromBLength = glm::length(awayFromB);
+    if (awayFromBLength <= 0.0) return b;
+    return glm::normalize(z * b +
+                          std::sqrt(std::max(0.0, 1.0 - z * z)) * awayFromB / awayFromBLength);
 }
 
 }  // namespace leaflux
