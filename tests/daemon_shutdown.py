@@ -48,15 +48,17 @@ def start(*arguments):
     fail("leafluxd did not start", log)
 
 
-def scene(samples):
+def scene(samples, leaves=1):
     s = pb.Scene(version=pb.PROTOCOL_VERSION_CURRENT)
     s.bands.add(name="PAR")
     s.optics.add(id="leaf").bands["PAR"].CopyFrom(pb.BandOptics(rho_upper=0.1, rho_lower=0.1))
     s.nodes.add(id=1, type=pb.NODE_TYPE_PLANT)
-    n = s.nodes.add(id=2, parent=1, type=pb.NODE_TYPE_LEAF, name="leaf")
-    n.organ.optics = "leaf"
-    n.organ.mesh.positions.extend([0, 0, 1, 0.1, 0, 1, 0.1, 0.1, 1])
-    n.organ.mesh.triangles.extend([0, 1, 2])
+    for k in range(leaves):
+        n = s.nodes.add(id=2 + k, parent=1, type=pb.NODE_TYPE_LEAF, name=f"leaf{k}" if k else "leaf")
+        n.organ.optics = "leaf"
+        z = 1 + 0.05 * k
+        n.organ.mesh.positions.extend([0, 0, z, 0.1, 0, z, 0.1, 0.1, z])
+        n.organ.mesh.triangles.extend([0, 1, 2])
     sun = s.suns.add()
     sun.direction.z = 1
     sun.normal_irradiance["PAR"] = 1000
@@ -86,9 +88,9 @@ class Pending:
         return reply, time.monotonic()
 
 
-def open_session(endpoint, samples):
+def open_session(endpoint, samples, leaves=1):
     with Client(endpoint, timeout_s=30) as client:
-        return client.open(*scene(samples))
+        return client.open(*scene(samples, leaves))
 
 
 def exit_status(daemon, timeout_s):
@@ -100,7 +102,9 @@ def exit_status(daemon, timeout_s):
 
 def grace_then_cancel():
     daemon, endpoint, log = start("--workers", "1", "--grace-seconds", "3")
-    slow = open_session(endpoint, 1 << 24)  # 5 to 10 s of one core
+    # 16 leaves of 2^24 paths: about 50 s of one core, cancelled after the grace (one leaf
+    # took 3.0 s on a fast machine and ended within it).
+    slow = open_session(endpoint, 1 << 24, 16)
     queued = open_session(endpoint, 16)
     in_flight = Pending(endpoint, slow)
     time.sleep(0.3)
