@@ -4,7 +4,10 @@
 // difference over the mean.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "solver/generate/generator.h"
 #include "solver/solve.h"
@@ -12,10 +15,12 @@
 namespace leaflux {
 namespace {
 
-Scene Canopy(int leaves, SkyDiscretization sky, double groundHalfWidthM, bool sun) {
+Scene Canopy(int leaves, SkyDiscretization sky, double groundHalfWidthM, bool sun,
+             double leafRho = 0.45, double groundRho = 0.3) {
     Scene scene;
     scene.bands = {{"NIR"}};
-    scene.optics = {{"leaf", {{0.45, 0.45, 0.45, 0.45}}}, {"ground", {{0.3, 0.3, 0.0, 0.0}}}};
+    scene.optics = {{"leaf", {{leafRho, leafRho, leafRho, leafRho}}},
+                    {"ground", {{groundRho, groundRho, 0.0, 0.0}}}};
     CanopyParameters canopy;
     canopy.leaves = leaves;
     canopy.widthM = 1.0;
@@ -101,6 +106,83 @@ TEST(HrcAccuracy, AGroundAroundTheCanopyDoesNotMakeItsLeavesCoarse) {
                 100 * errors[0], 100 * errors[1]);
     EXPECT_LT(errors[1], 1.5 * errors[0]);
     EXPECT_LT(errors[1], 0.05);
+}
+
+// RAMI's purist corner: leaves with ρ + τ = 1 over a white ground (here ±200 m) under a
+// uniform sky of 46 cones. The light field is then isotropic: every leaf side gets the
+// sky's irradiance and every light vector vanishes, whatever the leaves' places. A link's
+// light vector takes the mean of ω over its sender's solid angle (Estimator::Arrival):
+// taken towards a large patch's centre it pulled towards that centre with the whole
+// solid angle, and a leaf's |v| reached 0.088.
+TEST(HrcAccuracy, AnIsotropicFieldLightsEverySideAlikeFromEveryDirection) {
+    const int leaves = 300;
+    const Scene scene = Canopy(leaves, SkyDiscretization::kTurtle46, 200.0, false, 0.5, 1.0);
+    for (SolverKind kind : {SolverKind::kMonteCarlo, SolverKind::kHrc}) {
+        const Solution s = SolveWith(scene, kind, 1e-4, 4096);
+        double worst = 0.0, largest = 0.0, sum = 0.0, squares = 0.0;
+        for (int r = 0; r < leaves; ++r) {
+            const BandLight& b = s.light[r][0];
+            for (const auto& [e, error] : {std::pair{b.irradianceUpperWm2, b.stderrUpperWm2},
+                                           std::pair{b.irradianceLowerWm2, b.stderrLowerWm2}}) {
+                worst = std::max(worst, std::abs(e / 100.0 - 1.0));
+                sum += e, squares += e * e;
+                // Monte Carlo: each side within its noise (5.5 σ: 2e-5 over 600 sides; the
+                // cones' 0.26 % is far below it).
+                if (kind == SolverKind::kMonteCarlo) {
+                    EXPECT_NEAR(e, 100.0, 5.5 * error);
+                }
+            }
+            largest = std::max(largest, glm::length(b.LightVector()));
+        }
+        const double mean = sum / (2 * leaves);
+        std::printf("%s: mean side %.3f W/m², sd %.2f %%, worst %.2f %%, largest |v| %.3f\n",
+                    kind == SolverKind::kHrc ? "hrc" : "mc", mean,
+                    100 * std::sqrt(squares / (2 * leaves) - mean * mean) / mean, 100 * worst,
+                    largest);
+        if (kind == SolverKind::kHrc) {
+            // Nothing is absorbed: the mean side within 1 %, the balance's closure as the
+            // stability suite holds it (0.5 %) plus the cones' own discretisation (Monte
+            // Carlo's mean on them, printed above, 99.74 W/m²).
+            EXPECT_NEAR(mean, 100.0, 1.0);
+            EXPECT_LE(largest, 0.05);
+        }
+    }
+}
+
+// Under a sun and a sky of cones, over a grey ground: each leaf's light vector against
+// the Monte Carlo reference's, its length and, where it is over 0.2, its direction. With
+// links' vectors towards their senders' centres: worst length 0.030, directions p95 2.9°,
+// worst 7.3°; with the mean of ω over a plane sender, 0.029, 2.7° and 6.1°.
+TEST(HrcAccuracy, LightVectorsUnderSunAndSkyFollowTheReference) {
+    const int leaves = 250;
+    const Scene scene = Canopy(leaves, SkyDiscretization::kTurtle46, 10.0, true);
+    const Solution reference = SolveWith(scene, SolverKind::kMonteCarlo, 0.0, 8192);
+    const Solution hrc = SolveWith(scene, SolverKind::kHrc, 1e-4);
+    double worstLength = 0.0, worstAngle = 0.0, sumLength = 0.0;
+    std::vector<double> angles;
+    for (int r = 0; r < leaves; ++r) {
+        const glm::dvec3 want = reference.light[r][0].LightVector();
+        const glm::dvec3 got = hrc.light[r][0].LightVector();
+        const double dl = std::abs(glm::length(got) - glm::length(want));
+        worstLength = std::max(worstLength, dl);
+        sumLength += dl;
+        if (glm::length(want) > 0.2) {
+            const double c = glm::dot(got, want) / (glm::length(got) * glm::length(want));
+            angles.push_back(glm::degrees(std::acos(std::clamp(c, -1.0, 1.0))));
+            worstAngle = std::max(worstAngle, angles.back());
+        }
+    }
+    std::sort(angles.begin(), angles.end());
+    const double p95 = angles[angles.size() * 95 / 100];
+    std::printf(
+        "light vectors: |v| off by %.3f mean, %.3f worst; direction (%zu leaves with |v| > "
+        "0.2) median %.2f°, p95 %.2f°, worst %.2f°\n",
+        sumLength / leaves, worstLength, angles.size(), angles[angles.size() / 2], p95, worstAngle);
+    // Two references of 8,192 paths a leaf, on other seeds, differ by up to 0.025 in
+    // length and 6.2° in direction (p95 2.2°): at that budget the test sees the goal
+    // (within 0.05 and 5°) through the reference's noise.
+    EXPECT_LE(worstLength, 0.05);
+    EXPECT_LE(p95, 5.0);
 }
 
 }  // namespace

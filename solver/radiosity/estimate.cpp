@@ -60,6 +60,20 @@ SidedFormFactor Estimator::PlanesForm(std::uint32_t r, std::uint32_t s, Points r
     return form;
 }
 
+glm::dvec3 Estimator::Arrival(std::uint32_t r, std::uint32_t s) const {
+    const glm::dvec3& x = hierarchy_[r].centroid;
+    glm::dvec3 moment(0.0);
+    double solidAngle = 0.0;
+    for (std::uint32_t part : model_.PlaneParts(s)) {
+        const HrcNode& P = hierarchy_[part];
+        const double omega = model_.PartSolidAngle(part, x);
+        solidAngle += omega;
+        moment +=
+            P.patch ? TriangleMoment(x, P.a, P.b, P.c) : omega * glm::normalize(P.centroid - x);
+    }
+    return solidAngle > 0.0 ? moment / solidAngle : glm::normalize(hierarchy_[s].centroid - x);
+}
+
 Estimate Estimator::Pair(std::uint32_t r, std::uint32_t s, Points rule) const {
     const HrcNode& R = hierarchy_[r];
     const HrcNode& S = hierarchy_[s];

@@ -40,6 +40,11 @@ class Estimator {
     Estimator(const NodeModel& model, const Field& field)
         : hierarchy_(model.Nodes()), model_(model), field_(field) {}
 
+    // Plane s seen from R's centroid: the mean of ω over its solid angle Ω, ∫ ω dω / Ω
+    // (its patches' exactly, TriangleMoment; a flat cluster part's towards its centroid),
+    // shorter than 1 where s is seen wide: where an exact or sided link's light arrives
+    // from, for the light vector (NodeLink::toSender).
+    glm::dvec3 Arrival(std::uint32_t r, std::uint32_t s) const;
     // Node ← node, at least one of them a cluster, or plane ← plane one a flat cluster.
     Estimate Pair(std::uint32_t r, std::uint32_t s, Points rule = Points::kJudging) const;
     // Patch ← patch: Lambert's formula per side, averaged over points of R.

@@ -74,4 +74,20 @@ SidedFormFactor MeanPointToTriangle(const glm::dvec3& centre, const glm::dvec3* 
     return f;
 }
 
+glm::dvec3 TriangleMoment(const glm::dvec3& x, const glm::dvec3& a, const glm::dvec3& b,
+                          const glm::dvec3& c) {
+    const std::array<glm::dvec3, 3> triangle = {a, b, c};
+    glm::dvec3 sum(0.0);
+    glm::dvec3 r0 = triangle[2] - x;
+    for (const glm::dvec3& corner : triangle) {
+        const glm::dvec3 r1 = corner - x;
+        const glm::dvec3 cross = glm::cross(r0, r1);
+        const double length = glm::length(cross);
+        if (length > 0.0) sum += Angle(length, glm::dot(r0, r1)) * cross / length;
+        r0 = r1;
+    }
+    const glm::dvec3 toward = (triangle[0] + triangle[1] + triangle[2]) / 3.0 - x;
+    return (glm::dot(sum, toward) < 0.0 ? -0.5 : 0.5) * sum;
+}
+
 }  // namespace leaflux

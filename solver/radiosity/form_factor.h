@@ -26,4 +26,11 @@ SidedFormFactor MeanPointToTriangle(const glm::dvec3& centre, const glm::dvec3* 
                                     const glm::dvec3& n, const glm::dvec3& a, const glm::dvec3& b,
                                     const glm::dvec3& c, const double* weights = nullptr);
 
+// ∫ ω dω over the triangle a, b, c seen from x, ½ Σ θᵢ Γᵢ over its edges (θᵢ the angle an
+// edge subtends, Γᵢ the unit normal of the plane through x and it): the irradiance vector
+// of unit radiance, whose component along a normal is π F; its length is at most the
+// triangle's solid angle.
+glm::dvec3 TriangleMoment(const glm::dvec3& x, const glm::dvec3& a, const glm::dvec3& b,
+                          const glm::dvec3& c);
+
 }  // namespace leaflux

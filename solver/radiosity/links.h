@@ -55,7 +55,10 @@ struct NodeLink {
     // exact link's, F per side of R, but it is judged as a link between clusters.
     bool sided : 1 = false;
     std::uint16_t spread = 0;  // visibility spread of the rays that judged it, in 65535ths
-    glm::vec3 toSender{0.0f};  // unit, from R's centre
+    // From R's centre towards S: unit for a link from a cluster; for exact and sided links
+    // the mean of ω over S's solid angle (Estimate::arrival), so that the light vector
+    // takes ∫ L ω dω = L × transfer[2] × toSender.
+    glm::vec3 toSender{0.0f};
     // Exact: v F on R's upper and lower sides and v Ω (the solid angle of S at R's centre).
     // Sided: as exact. Else transfer[0]: for a cluster sender v / d², times its intensity;
     // for a plane sender v Ω / π (PlaneSolidAngle), times its radiosity (bounded however

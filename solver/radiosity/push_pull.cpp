@@ -178,7 +178,9 @@ void PushPull::PushSources(const Links& links, const std::vector<DirectionalSour
                 const double normal = sources[s].normalIrradiance[k] * visibility[s];
                 sides[k] += normal * std::abs(cosine);
                 if (incident) incident[k] += normal * std::abs(cosine);
-                integral[k] += normal;
+                // A cone of radius r brings L Ω (1 + cos r) / 2 onto a plane facing it, and
+                // that times its axis is its ∫ L ω dω; its ∫ L dω is L Ω.
+                integral[k] += normal * 2.0 / (1.0 + sources[s].cosRadius);
                 moment[k] += normal * sources[s].toward;
             }
         }

@@ -188,7 +188,7 @@ Refiner::Verdict Refiner::JudgePair(std::uint32_t r, std::uint32_t s) const {
     link.senderPlane = model_.Planar(s);
     link.senderSide = static_cast<std::uint8_t>(e.senderSide);
     link.spread = static_cast<std::uint16_t>(std::lround(sight.spread * NodeLink::kUnit));
-    link.toSender = e.toSender;
+    link.toSender = exact || e.sided ? estimator_.Arrival(r, s) : e.toSender;
     link.reach = static_cast<float>(e.reach);
     link.sideReach = static_cast<float>(e.sideReach);
     link.geometricError = static_cast<float>(e.geometricError);
