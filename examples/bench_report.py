@@ -8,7 +8,7 @@ between its `<!-- report:NAME -->` and `<!-- /report:NAME -->` markers, so that 
 what the last run measured and nothing else: docs/results.md holds every table (one section
 per scene), README.md one summary of the error tables (`report:summary`).
 
-Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth,import]
+Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability]
                       [--scenes a,b]
                       [--scaling-solvers hrc,mc]
        bench_report.py --tables-only [--only ...]   # rewrite from examples/report/, run nothing
@@ -16,6 +16,7 @@ The growth part reads the demo's out/demo/ (run scripts/demo.sh first).
 """
 import argparse
 import csv
+import json
 import os
 import re
 import shutil
@@ -348,6 +349,72 @@ def phase_spread_section(build, out, run=True):
                      f"{number(r['intercepted_rep_error_pct'])} ({number(r['intercepted_noise_pct'])}) | {other} |")
     return "\n".join(table)
 
+# The stability suite's tests by scene, in the table's order: (test name, what it is).
+STABILITY = [
+    ("DenseCanopyConservesEnergy", "dense canopy (120 leaves, LAI 4, grey ground), ρ + τ = {scatter}"),
+    ("ClosedBoxAbsorbsAllTheLampEmits", "closed box lit by a lamp, ρ = {scatter}, at ε = 1e-6"),
+    ("LeavesOneMicrometreApart", "two leaves 1 µm apart"),
+    ("IntersectingLeaves", "intersecting leaves"),
+    ("LampOneMillimetreBelowALeaf", "a lamp 1 mm under a leaf"),
+    ("SunHalfADegreeAboveTheHorizon", "sun 0.5° above the horizon on a vertical leaf"),
+    ("ReflectanceEqualToTransmittance", "a canopy with ρ = τ"),
+    ("SunExactlyAtADirectionSetVertex", "sun exactly on a direction-set vertex"),
+    ("CoordinatesOffsetAHundredKilometres", "coordinates offset by 10⁵ m"),
+    ("LeavesOfOneMillimetreAndTenMetres", "leaves of 1 mm and 10 m"),
+    ("TheBrightestSunAcceptedGivesFiniteLight", "the brightest sun accepted"),
+    ("OneLeaf", "one leaf"),
+    ("BlackLeavesAbsorbEverything", "black leaves"),
+]
+
+
+def stability_section(build, out, run=True):
+    """The stability suite (tests/stability_test.cpp) for every solver: the sweeps,
+    extrapolation jumps and energy balance each run records (gtest's JSON output)."""
+    csv_path = os.path.join(REPORT, "stability.csv")
+    if run:
+        os.makedirs(out, exist_ok=True)
+        json_path = os.path.join(out, "stability.json")
+        subprocess.run([os.path.join(build, "tests", "leaflux_tests"), "--gtest_filter=*Stability*",
+                        f"--gtest_output=json:{json_path}"], check=True, capture_output=True)
+        rows = []
+        for suite in json.load(open(json_path))["testsuites"]:
+            for test in suite["testsuite"]:
+                if "balance_residual" not in test:
+                    continue
+                name, solver = test["name"].split("/")
+                scatter = ""
+                if "_scatter" in solver:
+                    solver, scatter = solver.split("_scatter")
+                    scatter = f"{float('0.' + scatter):g}"
+                rows.append({"test": name, "solver": solver, "scatter": scatter,
+                             "iterations": test["iterations"], "extrapolations": test["extrapolations"],
+                             "balance_pct": 100 * float(test["balance_residual"]),
+                             "balance_stderr_pct": 100 * float(test["balance_stderr"]),
+                             "passed": "failures" not in test})
+        with open(csv_path, "w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+            writer.writeheader()
+            writer.writerows(rows)
+    rows = list(csv.DictReader(open(csv_path)))
+    solvers = [s for s in ("hrc", "instanced", "mc") if any(r["solver"] == s for r in rows)]
+    names = {"hrc": "HRC (ε = 1e-5)", "instanced": "instanced (ε = 1e-5)", "mc": "Monte Carlo (1,024 paths)"}
+    table = ["| scene | " + " | ".join(f"{names[s]}: sweeps (jumps), balance ± s.e. %" for s in solvers) + " |",
+             "|---" * (len(solvers) + 1) + "|"]
+    for test, what in STABILITY:
+        for scatter in dict.fromkeys(r["scatter"] for r in rows if r["test"] == test):
+            cells = []
+            for solver in solvers:
+                at = [r for r in rows if (r["test"], r["solver"], r["scatter"]) == (test, solver, scatter)]
+                if not at:
+                    cells.append("–")
+                    continue
+                r = at[0]
+                sweeps = "" if solver == "mc" else f"{r['iterations']} ({r['extrapolations']}), "
+                mark = "" if r["passed"] == "True" else " **failed**"
+                cells.append(f"{sweeps}{float(r['balance_pct']):+.2f} ± {float(r['balance_stderr_pct']):.2f}{mark}")
+            table.append(f"| {what.format(scatter=scatter)} | " + " | ".join(cells) + " |")
+    return "\n".join(table)
+
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -355,7 +422,7 @@ def main():
                         help="build directory (default: build/release)")
     parser.add_argument("out", nargs="?", default=os.path.join(ROOT, "out", "report"),
                         help="directory of the runs' files (default: out/report)")
-    parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth,import",
+    parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability",
                         help="parts to run (default: all)")
     parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
     parser.add_argument("--scaling-solvers", default="hrc,mc",
@@ -395,6 +462,8 @@ def main():
     if "import" in parts:
         update(RESULTS, "import", import_section(build, os.path.join(out, "import"), run,
                                                  args.import_largest))
+    if "stability" in parts:
+        update(RESULTS, "stability", stability_section(build, os.path.join(out, "stability"), run))
     print(f"sections {args.only} rewritten in docs/results.md"
           f"{' and the summary in README.md' if 'error' in parts else ''}; files in {REPORT}")
 

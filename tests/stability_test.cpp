@@ -59,6 +59,10 @@ Solution SolveAndRecord(const PreparedScene& prepared, const SolverSettings& set
     ::testing::Test::RecordProperty("extrapolations", solution.stats.extrapolations);
     ::testing::Test::RecordProperty("residual", std::to_string(solution.stats.residual));
     ::testing::Test::RecordProperty("balance_residual", std::to_string(total.RelativeResidual()));
+    ::testing::Test::RecordProperty(
+        "balance_stderr",
+        std::to_string(total.incidentW > 0.0 ? std::max(total.stderrW, 0.0) / total.incidentW
+                                             : 0.0));
     ExpectFiniteLight(solution);
     for (const EnergyBalance& e : solution.balance) {
         EXPECT_TRUE(std::isfinite(e.incidentW) && std::isfinite(e.absorbedW) &&

@@ -59,6 +59,8 @@ Sight LinkVisibility::BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet se
                                      std::int64_t& rays) const {
     Random random(StreamSeed(static_cast<std::uint64_t>(set), r, s));
     const int count = visibilityRays_;
+    thread_local std::vector<int> strata;  // the sender's, in a random order
+    RandomStrata(random, strata, count);
     const HrcNode& S = hierarchy_[s];
     const bool boxes = !occlusion_.TrianglesOnly();
     const bool held = model_.Held(s);
@@ -67,8 +69,7 @@ Sight LinkVisibility::BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet se
     for (int i = 0; i < count; ++i) {
         const Hierarchy::Point p =
             hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
-        const double u = (ShuffledStratum(i, count) + random.Uniform()) / count,
-                     v = random.Uniform();
+        const double u = (strata[i] + random.Uniform()) / count, v = random.Uniform();
         // Each ray weighted by its estimate of π F(x → S): where S is near (its radius
         // more than kNear of its distance), Ω |n · ω| for a direction uniform in S's solid
         // angle Ω; farther, A_S |n · ω| |cos θy| / d² to a point uniform on S, that kernel
@@ -129,6 +130,8 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set,
     if (hierarchy_[r].patch && hierarchy_[s].patch) return BetweenPatches(r, s, set, rays);
     Random random(StreamSeed(static_cast<std::uint64_t>(set), r, s));
     const int count = visibilityRays_;
+    thread_local std::vector<int> strata;  // the sender's, in a random order
+    RandomStrata(random, strata, count);
     const bool fromCluster = !hierarchy_[s].patch;
     const bool boxes = !occlusion_.TrianglesOnly();
     const bool held = model_.Held(s);
@@ -139,8 +142,8 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set,
         const Hierarchy::Point p =
             hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
         // Stratified over S as well: a cluster's children each get their share of rays.
-        const Hierarchy::Point q = hierarchy_.Sample(
-            s, (ShuffledStratum(i, count) + random.Uniform()) / count, random.Uniform());
+        const Hierarchy::Point q =
+            hierarchy_.Sample(s, (strata[i] + random.Uniform()) / count, random.Uniform());
         const glm::dvec3 d = q.position - p.position;
         const double distance = glm::length(d);
         if (distance <= 0.0) continue;

@@ -57,9 +57,12 @@ class LinkVisibility {
     // factor's kernel |cos θx| |cos θy| / |x − y|² (the receiving cosine as push-down hands
     // the light to patches). Unweighted, far pairs count as much as near ones and are more
     // often blocked: the 500-leaf canopy at ρ = τ = 0.45 lost 2.3 % of its NIR that way.
-    // The points are stratified over both ends: each child of a sending cluster gets its
-    // share of the rays (drawn at random, the eight rays of a two-leaf cluster whose lower leaf is
-    // hidden fell so that it sent 13 % too little: HrcExposure.AClusterSendsOnly…).
+    // The points are stratified over both ends, the sender's strata paired with the
+    // receiver's in a random order (RandomStrata): each child of a sending cluster gets its
+    // share of the rays (drawn at random, the eight rays of a two-leaf cluster whose lower
+    // leaf is hidden fell so that it sent 13 % too little: HrcExposure.AClusterSendsOnly…),
+    // and no pair of strata is favoured (paired in a fixed order, the closed box of
+    // ρ = 0.999 lost 1.2 % of its light, 0.19 % now).
     // Between two patches, the share of the form factor that is visible, from points x of
     // r each weighted by its estimate of its own form factor F(x → s); where s is near,
     // along a direction uniform in its solid angle (BetweenPatches): a visibility in [0, 1]

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <glm/gtc/constants.hpp>
+#include <vector>
 
 namespace leaflux {
 
@@ -97,6 +98,19 @@ inline glm::dvec3 UniformCone(const glm::dvec3& axis, double cosMax, double u, d
 // not pair stratum with stratum.
 inline int ShuffledStratum(int i, int count) {
     return static_cast<int>((static_cast<std::int64_t>(i) * 7919) % count);
+}
+
+// 0 .. count − 1 in an order drawn from `random` (Fisher–Yates): a second coordinate
+// stratified over the same samples, its strata taken in this order, keeps each sample's
+// pair uniform (Latin hypercube sampling); in a fixed order, pairs stratum i only with
+// stratum π(i), which is a bias where the integrand couples the two.
+inline void RandomStrata(Random& random, std::vector<int>& order, int count) {
+    order.resize(static_cast<std::size_t>(count));
+    for (int i = 0; i < count; ++i) order[i] = i;
+    for (int i = count - 1; i > 0; --i) {
+        const int j = std::min(i, static_cast<int>(random.Uniform() * (i + 1)));
+        std::swap(order[i], order[j]);
+    }
 }
 
 // Uniform on a triangle: barycentric weights of a, b, c.
