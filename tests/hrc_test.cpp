@@ -394,6 +394,18 @@ TEST(HrcTree, LinkAuditFindsTheLightThatDoesNotEscapeCoveredOnce) {
     RecordProperty("uncovered_w", std::to_string(uncovered));
 }
 
+// A plant (node 10) of two 20 cm square leaves, "top" (node 1) 10 cm above "bottom"
+// (node 2) at z = 1 m, of the given optics.
+void AddStackedPlant(Scene& scene, const std::string& topOptics, const std::string& bottomOptics) {
+    Node plant;
+    plant.id = 10;
+    plant.type = NodeType::kPlant;
+    plant.name = "plant";
+    scene.nodes.push_back(plant);
+    scene.nodes.push_back(OrganNode(1, "top", Rectangle(0.2, 0.2, 1.1), topOptics, 10));
+    scene.nodes.push_back(OrganNode(2, "bottom", Rectangle(0.2, 0.2, 1.0), bottomOptics, 10));
+}
+
 // A cluster hands its children the light it gathers weighted by how open each is towards
 // it (HrcOptions::exposureRays). Two black leaves of one plant, one above the other, under
 // a small lamp 5 m up that lights the plant through one link: handed down evenly, each
@@ -401,13 +413,7 @@ TEST(HrcTree, LinkAuditFindsTheLightThatDoesNotEscapeCoveredOnce) {
 // Carlo reference finds, and the two absorb the same power either way.
 TEST(HrcExposure, SharesOutTheLightAClusterGathersTowardsTheOpenLeaf) {
     Scene scene = OneBandScene({{"leaf", Leaf(0, 0)}, {"lamp", Opaque(0)}});
-    Node plant;
-    plant.id = 10;
-    plant.type = NodeType::kPlant;
-    plant.name = "plant";
-    scene.nodes.push_back(plant);
-    scene.nodes.push_back(OrganNode(1, "top", Rectangle(0.2, 0.2, 1.1), "leaf", 10));
-    scene.nodes.push_back(OrganNode(2, "bottom", Rectangle(0.2, 0.2, 1.0), "leaf", 10));
+    AddStackedPlant(scene, "leaf", "leaf");
     scene.sources.emitters.push_back({"lamp", Rectangle(0.3, 0.3, 6.0, true), {5000.0}, "lamp"});
     scene.Validate();
     const PreparedScene prepared(scene);
@@ -452,13 +458,7 @@ TEST(HrcExposure, SharesOutTheLightAClusterGathersTowardsTheOpenLeaf) {
 TEST(HrcExposure, AClusterSendsOnlyWhatItsOpenLeavesSend) {
     Scene scene = OneBandScene(
         {{"top", {0.5, 0.0, 0.0, 0.0}}, {"bottom", Leaf(0.5, 0.0)}, {"black", Leaf(0.0, 0.0)}});
-    Node plant;
-    plant.id = 10;
-    plant.type = NodeType::kPlant;
-    plant.name = "plant";
-    scene.nodes.push_back(plant);
-    scene.nodes.push_back(OrganNode(1, "top", Rectangle(0.2, 0.2, 1.1), "top", 10));
-    scene.nodes.push_back(OrganNode(2, "bottom", Rectangle(0.2, 0.2, 1.0), "bottom", 10));
+    AddStackedPlant(scene, "top", "bottom");
     scene.nodes.push_back(OrganNode(3, "sensor", Rectangle(0.2, 0.2, 6.0, true), "black"));
     scene.sources.suns.push_back(SunAt(30.0, 90.0, 1000.0));
     scene.Validate();
