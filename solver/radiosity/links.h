@@ -56,7 +56,7 @@ struct NodeLink {
     bool sided : 1 = false;
     std::uint16_t spread = 0;  // visibility spread of the rays that judged it, in 65535ths
     // From R's centre towards S: unit for a link from a cluster; for exact and sided links
-    // the mean of ω over S's solid angle (Estimate::arrival), so that the light vector
+    // the mean of ω over S's solid angle (Estimator::Arrival), so that the light vector
     // takes ∫ L ω dω = L × transfer[2] × toSender.
     glm::vec3 toSender{0.0f};
     // Exact: v F on R's upper and lower sides and v Ω (the solid angle of S at R's centre).

@@ -55,6 +55,17 @@ double LinkVisibility::HeldTransmittance(const Hierarchy::Point& p, const glm::d
                : 1.0;
 }
 
+double LinkVisibility::Passed(const Hierarchy::Point& p, std::int32_t closedEnd,
+                              const glm::dvec3& direction, double length, bool held) const {
+    const RayStart start{p.position, p.triangle};
+    if (held) return HeldTransmittance(p, direction, length);
+    if (occlusion_.TrianglesOnly()) {  // triangles alone: a ray passes or not
+        return occlusion_.Triangles().Occluded(start, direction, length) ? 0.0 : 1.0;
+    }
+    const std::int32_t ends[2] = {p.closed, closedEnd};
+    return occlusion_.LocalTransmittance(start, direction, length, Exclusion(ends));
+}
+
 Sight LinkVisibility::BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet set,
                                      std::int64_t& rays) const {
     Random random(StreamSeed(static_cast<std::uint64_t>(set), r, s));
@@ -62,7 +73,6 @@ Sight LinkVisibility::BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet se
     thread_local std::vector<int> strata;  // the sender's, in a random order
     RandomStrata(random, strata, count);
     const HrcNode& S = hierarchy_[s];
-    const bool boxes = !occlusion_.TrianglesOnly();
     const bool held = model_.Held(s);
     double seen = 0.0, total = 0.0, passed = 0.0;
     int traced = 0;
@@ -107,15 +117,7 @@ Sight LinkVisibility::BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet se
             passed += 1.0;
             continue;
         }
-        const RayStart start{p.position, p.triangle};
-        double through;
-        if (!boxes && !held) {  // triangles alone: a ray passes or not
-            through = occlusion_.Triangles().Occluded(start, omega, length) ? 0.0 : 1.0;
-        } else {
-            const std::int32_t ends[2] = {p.closed, -1};
-            through = held ? HeldTransmittance(p, omega, length)
-                           : occlusion_.LocalTransmittance(start, omega, length, Exclusion(ends));
-        }
+        const double through = Passed(p, -1, omega, length, held);
         seen += weight * through;
         passed += through;
     }
@@ -133,7 +135,6 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set,
     thread_local std::vector<int> strata;  // the sender's, in a random order
     RandomStrata(random, strata, count);
     const bool fromCluster = !hierarchy_[s].patch;
-    const bool boxes = !occlusion_.TrianglesOnly();
     const bool held = model_.Held(s);
     double visible = 0.0, total = 0.0, visibleLight = 0.0, totalLight = 0.0;
     int traced = 0;
@@ -156,19 +157,7 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set,
         ++rays, ++traced;
         total += weight;
         totalLight += light;
-        const RayStart start{p.position, p.triangle};
-        const double length = distance * (1.0 - 1e-4);
-        if (!boxes && !held) {  // triangles alone: a ray passes or not
-            if (occlusion_.Triangles().Occluded(start, d / distance, length)) continue;
-            visible += weight;
-            visibleLight += light;
-            passed += 1.0;
-            continue;
-        }
-        const std::int32_t ends[2] = {p.closed, q.closed};
-        const double through =
-            held ? HeldTransmittance(p, d / distance, length)
-                 : occlusion_.LocalTransmittance(start, d / distance, length, Exclusion(ends));
+        const double through = Passed(p, q.closed, d / distance, distance * (1.0 - 1e-4), held);
         visible += weight * through;
         visibleLight += light * through;
         passed += through;

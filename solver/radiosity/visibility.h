@@ -94,6 +94,11 @@ class LinkVisibility {
 
   private:
     Sight BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays) const;
+    // What passes along a link's ray from p, `length` long, towards an end inside closed
+    // instance `closedEnd` (−1: none) or a surface held from outside (`held`): 0 or 1
+    // through triangles alone, else the transmittance, the ray's own ends left out.
+    double Passed(const Hierarchy::Point& p, std::int32_t closedEnd, const glm::dvec3& direction,
+                  double length, bool held) const;
     // Along a ray from p towards a held surface, `length` long.
     double HeldTransmittance(const Hierarchy::Point& p, const glm::dvec3& direction,
                              double length) const;
