@@ -173,8 +173,9 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set,
 }
 
 double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
-                                  const DirectionalSource& light, std::int64_t& rays) const {
-    Random random(StreamSeed(0x50C, r, source));
+                                  const DirectionalSource& light, RaySet set,
+                                  std::int64_t& rays) const {
+    Random random(StreamSeed(set == RaySet::kJudging ? 0x50C : 0x50D, r, source));
     const int count = sourceRays_;
     const bool beam = light.cosRadius >= 1.0;
     thread_local std::vector<RayStart> starts;

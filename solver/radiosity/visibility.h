@@ -89,8 +89,9 @@ class LinkVisibility {
     // back above the horizon where a sky cone dips below it, as the reference does),
     // weighted by |n · ω|, the weight with which push-down hands the source's light to each
     // patch.
+    // `set` picks the stream of rays, as for links between nodes.
     double FromSource(std::uint32_t r, std::uint32_t source, const DirectionalSource& light,
-                      std::int64_t& rays) const;
+                      RaySet set, std::int64_t& rays) const;
 
   private:
     Sight BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays) const;
