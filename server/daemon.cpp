@@ -130,13 +130,17 @@ v1::Reply ErrorReply(v1::ErrorCode code, const std::string& message, const std::
     return reply;
 }
 
-Session::Session(Scene scene, MeshLibrary meshes, SolverSettings settings, SceneLimits limits,
+Session::Session(Scene scene, MeshLibrary meshes, SessionSolver solver, SceneLimits limits,
                  std::int64_t lastCycle)
     : store_(std::move(scene)),
       meshes_(std::move(meshes)),
-      settings_(std::move(settings)),
+      solver_(std::move(solver)),
       limits_(limits),
       lastCycle_(lastCycle) {
+    if (solver_.instanced && store_.Get().periodic) {
+        throw InputError(ErrorCode::kUnsupported, "settings.solver",
+                         "the instanced solver does not repeat a periodic tile; use hrc or mc");
+    }
     if (store_.Get().periodic) CheckPeriodicTile(store_.Get(), store_.Flat(), limits_);
     Count();
 }
@@ -250,7 +254,7 @@ v1::CycleResult Session::Solve(const v1::OutputRequest& outputs) const {
     const Scene& solved = allBands ? scene : subset;
     if (!allBands) wanted = order;
     const bool lightVectors = !outputs.has_light_vectors() || outputs.light_vectors();
-    SolverSettings settings = settings_;
+    SolverSettings settings = solver_.settings;
     settings.hrc.lightVectors = lightVectors;
     Clock::time_point start = Clock::now();
     FlatScene flat = store_.Flat();
@@ -258,11 +262,27 @@ v1::CycleResult Session::Solve(const v1::OutputRequest& outputs) const {
     const PreparedScene prepared(solved, std::move(flat));  // the bands do not change the geometry
     spdlog::debug("scene flattened and its ray engine built in {:.1f} ms", Milliseconds(start));
     start = Clock::now();
-    const Solution solution = leaflux::Solve(prepared, settings);
+    std::optional<InstancedStats> instanced;
+    Solution solution;
+    if (solver_.instanced) {
+        InstancedOptions options = solver_.instanced->options;
+        options.hrc = settings.hrc;
+        options.hrc.directionalInstances = solver_.instanced->options.hrc.directionalInstances;
+        InstancedSolution run =
+            SolveInstanced(solved, prepared.Flat(),
+                           solver_.instanced->shadowsByGeometry ? &prepared.Rays() : nullptr,
+                           solver_.instanced->policy, *solver_.database, options);
+        solution = std::move(run.solution);
+        instanced = std::move(run.stats);
+    } else {
+        solution = leaflux::Solve(prepared, settings);
+    }
     spdlog::debug("solved in {:.1f} ms", Milliseconds(start));
     v1::CycleResult result;
     if (outputs.leaves()) {
         for (std::size_t r = 0; r < prepared.Flat().receivers.size(); ++r) {
+            // Organs inside a structure solved whole have no light of their own.
+            if (!solution.unsolved.empty() && solution.unsolved[r]) continue;
             const Receiver& receiver = prepared.Flat().receivers[r];
             v1::OrganLight* organ = result.add_organs();
             organ->set_node(receiver.node);
@@ -292,6 +312,17 @@ v1::CycleResult Session::Solve(const v1::OutputRequest& outputs) const {
     stats->set_iterations(solution.stats.iterations);
     stats->set_residual(solution.stats.residual);
     stats->set_threads(solution.stats.threads);
+    if (instanced) {
+        int opened = 0;
+        for (const InstancedStats::Depth& d : instanced->depths) opened += d.opened;
+        stats->set_instances_opened(opened);
+        stats->set_phase_functions_computed(instanced->originalsComputed);
+        stats->set_phase_functions_reused(instanced->originalsReused);
+        stats->set_phase_compute_seconds(instanced->originalSeconds);
+        stats->set_phase_reuse_seconds(instanced->reuseSeconds);
+        stats->set_solving_seconds(instanced->solveSeconds);
+        stats->set_phase_db_health(solver_.database->Health());
+    }
     for (int b : wanted) {
         v1::EnergyBalance* balance = stats->add_balance();
         balance->set_band(solved.bands[b].name);
@@ -302,7 +333,15 @@ v1::CycleResult Session::Solve(const v1::OutputRequest& outputs) const {
     return result;
 }
 
-Daemon::Daemon(DaemonLimits limits) : limits_(limits) {}
+Daemon::Daemon(DaemonLimits limits, DaemonPhaseFunctions phase)
+    : limits_(limits), phase_(std::move(phase)) {
+    PhaseDatabaseOptions options = phase_.database;
+    options.degradeToMemory = true;  // a daemon serves on without its file
+    phaseDb_ = std::make_shared<PhaseDatabase>(options);
+    if (phaseDb_->Persistent()) {  // else the database has logged why not
+        spdlog::info("phase-function database {}", options.path);
+    }
+}
 
 std::string Daemon::Handle(const std::string& bytes) {
     v1::Request request;
@@ -397,14 +436,23 @@ v1::Reply Daemon::Handle(const v1::Request& request) {
     return reply;
 }
 
-SolverSettings Daemon::Settings(const v1::SolverSettings& in) const {
-    SolverSettings settings = SettingsFromProto(in);
+SessionSolver Daemon::Settings(const v1::SolverSettings& in, const std::string& species) const {
+    SessionSolver solver;
+    SolverSettings& settings = solver.settings;
+    settings = SettingsFromProto(in);
     if (limits_.solverThreads > 0) {
         int& threads = settings.hrc.threads;
         threads = threads == 0 ? limits_.solverThreads : std::min(threads, limits_.solverThreads);
         settings.monteCarlo.threads = threads;
     }
-    return settings;
+    if (in.solver() == v1::SOLVER_KIND_INSTANCED) {
+        solver.instanced = InstancedRunFromProto(in.instanced(), species, phase_.policyDir);
+        solver.database = phaseDb_;
+    } else if (in.has_instanced()) {
+        throw InputError(ErrorCode::kInvalidArgument, "settings.instanced",
+                         "is for SOLVER_KIND_INSTANCED alone");
+    }
+    return solver;
 }
 
 std::shared_ptr<Session> Daemon::Find(const std::string& id) {
@@ -421,9 +469,9 @@ v1::Reply Daemon::Open(const v1::OpenSession& request) {
                          "the daemon reads no files: send the geometry");
     }
     Scene scene = FromProto(request.scene(), "", limits_.scene);
-    SolverSettings settings = Settings(request.settings());
+    SessionSolver solver = Settings(request.settings(), request.species());
     auto session = std::make_shared<Session>(std::move(scene), MeshesFromProto(request.scene()),
-                                             std::move(settings), limits_.scene);
+                                             std::move(solver), limits_.scene);
     std::string id;
     {
         std::lock_guard lock(mutex_);
@@ -467,10 +515,10 @@ v1::Reply Daemon::Resynchronise(const v1::Resync& request) {
                          "the daemon reads no files: send the geometry");
     }
     Scene scene = FromProto(request.scene(), "", limits_.scene);
-    SolverSettings settings = Settings(request.settings());
+    SessionSolver solver = Settings(request.settings(), request.species());
     auto session =
         std::make_shared<Session>(std::move(scene), MeshesFromProto(request.scene()),
-                                  std::move(settings), limits_.scene, request.last_cycle());
+                                  std::move(solver), limits_.scene, request.last_cycle());
     {
         std::lock_guard lock(mutex_);
         if (!sessions_.count(request.session()) && sessions_.size() >= limits_.maxSessions) {
@@ -491,6 +539,19 @@ v1::Reply Daemon::Status(const v1::StatusRequest& request) {
     v1::StatusReply* status = reply.mutable_status();
     status->set_requests(requests_);
     status->set_max_message_bytes(static_cast<std::int64_t>(limits_.maxMessageBytes));
+    {
+        const PhaseDatabaseStats db = phaseDb_->Stats();
+        v1::PhaseDatabaseStatus* out = status->mutable_phase_db();
+        out->set_path(phase_.database.path);
+        out->set_persistent(db.persistent);
+        out->set_health(db.health);
+        out->set_memory_entries(db.memoryEntries);
+        out->set_memory_bytes(db.memoryBytes);
+        out->set_memory_cap_mb(phase_.database.memoryCapMb);
+        out->set_computed(db.computed);
+        out->set_reused(db.memoryHits + db.diskHits + db.awaited);
+        out->set_stored(db.stored);
+    }
     std::lock_guard lock(mutex_);  // counts only: never waits for a solve
     status->set_session_count(static_cast<int>(sessions_.size()));
     if (request.session().empty()) return reply;  // ids are credentials: none is listed

@@ -18,7 +18,9 @@
 #include <string>
 
 #include "leaflux.pb.h"
+#include "server/instanced_settings.h"
 #include "server/scene_proto.h"
+#include "solver/instancing/phase_db.h"
 #include "solver/scene/scene_store.h"
 #include "solver/solve.h"
 
@@ -31,11 +33,29 @@ struct DaemonLimits {
     std::size_t maxMessageBytes = 0;  // the transport's limit, for Status (0: not told)
 };
 
+// The daemon's instantiation: its phase-function database, which every session of the
+// instanced solver shares, and where it finds policies by name and species.
+struct DaemonPhaseFunctions {
+    // path "" keeps the functions in memory (--no-phase-db); a file that cannot be opened
+    // is reported (Health) and the daemon goes on in memory, whatever degradeToMemory says.
+    PhaseDatabaseOptions database;
+    std::string policyDir;  // --policy-dir; "" none
+};
+
+// How a session solves: the solver's settings and, for the instanced solver, its run and
+// the daemon's database.
+struct SessionSolver {
+    SolverSettings settings;
+    std::optional<InstancedRun> instanced;
+    std::shared_ptr<PhaseDatabase> database;  // set with `instanced`
+};
+
 // One growth model's scene and solver settings.
 class Session {
   public:
-    // Throws TooLarge when the scene's periodic tile is too small for its geometry.
-    Session(Scene scene, MeshLibrary meshes, SolverSettings settings, SceneLimits limits,
+    // Throws TooLarge when the scene's periodic tile is too small for its geometry, and
+    // InputError (settings.solver) for the instanced solver on a periodic scene.
+    Session(Scene scene, MeshLibrary meshes, SessionSolver solver, SceneLimits limits,
             std::int64_t lastCycle = 0);
 
     // Checks a cycle's number, counts, delta and suns against the scene they make, applies
@@ -60,7 +80,7 @@ class Session {
 
     SceneStore store_;
     MeshLibrary meshes_;
-    SolverSettings settings_;
+    SessionSolver solver_;
     SceneLimits limits_;
     // The last cycle's result and the outputs it answered (serialised), for a cycle that
     // changes nothing: the solvers are deterministic, so it would get the same light.
@@ -76,7 +96,7 @@ bool IsSessionId(const std::string& id);
 
 class Daemon {
   public:
-    explicit Daemon(DaemonLimits limits = {});
+    explicit Daemon(DaemonLimits limits = {}, DaemonPhaseFunctions phase = {});
 
     // Answers one encoded Request with one encoded Reply.
     std::string Handle(const std::string& request);
@@ -86,6 +106,8 @@ class Daemon {
     static std::string KeyOf(const v1::Request& request);
 
     bool ShutdownRequested() const { return shutdown_; }
+    // The database every instanced session shares (never null).
+    PhaseDatabase& PhaseFunctions() { return *phaseDb_; }
 
   private:
     v1::Reply Open(const v1::OpenSession& request);
@@ -94,10 +116,13 @@ class Daemon {
     v1::Reply Status(const v1::StatusRequest& request);
     v1::Reply Close(const v1::CloseSession& request);
     std::shared_ptr<Session> Find(const std::string& id);
-    // A session's solver settings, its threads within the daemon's limit.
-    SolverSettings Settings(const v1::SolverSettings& in) const;
+    // A session's solver settings, its threads within the daemon's limit; for the
+    // instanced solver its run (policy by `species`) on the daemon's database.
+    SessionSolver Settings(const v1::SolverSettings& in, const std::string& species) const;
 
     DaemonLimits limits_;
+    DaemonPhaseFunctions phase_;
+    std::shared_ptr<PhaseDatabase> phaseDb_;
     std::mutex mutex_;  // guards the map, never held while solving
     std::map<std::string, std::shared_ptr<Session>> sessions_;
     std::atomic<std::int64_t> requests_{0};

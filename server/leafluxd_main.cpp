@@ -5,8 +5,9 @@
 // answered ERROR_CODE_SHUTTING_DOWN), the queued ones are refused the same way, the solves
 // in flight get --grace-seconds to end and are then answered SHUTTING_DOWN and abandoned:
 // the solvers cannot be interrupted, so the process exits without waiting for them.
-// Nothing persistent is written by a request, so nothing is left half-written. A second
-// signal ends the process at once.
+// The one thing a request writes is the phase-function database, a row per transaction:
+// a solve abandoned mid-computation stores nothing, and before exiting the database's
+// committed rows are flushed into its file. A second signal ends the process at once.
 #include <spdlog/sinks/basic_file_sink.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -21,6 +22,7 @@
 #include "server/daemon.h"
 #include "server/executor.h"
 #include "server/transport.h"
+#include "solver/instancing/phase_db.h"
 
 namespace {
 std::atomic<int> signals{0};
@@ -40,6 +42,9 @@ int main(int argc, char** argv) {
     int workers = 2;
     double graceSeconds = 20.0;
     std::string curveKeyFile;
+    DaemonPhaseFunctions phase;
+    phase.database.path = DefaultPhaseDatabasePath();
+    bool noPhaseDb = false;
     app.add_option("--bind", bind,
                    "ZeroMQ endpoint to serve: tcp://HOST:PORT (loopback by default; "
                    "tcp://[::1]:PORT is loopback too), ipc://PATH")
@@ -89,7 +94,24 @@ int main(int argc, char** argv) {
                    "ERROR_CODE_TOO_LARGE, and a frame over twice this closes the connection")
         ->check(CLI::Range(1, 4096))
         ->capture_default_str();
+    app.add_option("--phase-db", phase.database.path,
+                   "Phase-function database file, which every session of the instanced solver "
+                   "reads and extends and a restarted daemon reuses; one that cannot be opened "
+                   "(corrupt, foreign, read-only) is reported in the log and the replies, and "
+                   "the daemon goes on in memory, never writing a file it did not create")
+        ->capture_default_str();
+    app.add_flag("--no-phase-db", noPhaseDb,
+                 "Keep the phase functions in memory only, for this run");
+    app.add_option("--phase-db-mb", phase.database.memoryCapMb,
+                   "The phase-function database's buffer in memory (MB)")
+        ->check(CLI::Range(1.0, 1e6))
+        ->capture_default_str();
+    app.add_option("--policy-dir", phase.policyDir,
+                   "Folder of instantiation policies (DIR/NAME.txtpb): a session names one, "
+                   "or gets the one of its species, else the built-in general policy")
+        ->check(CLI::ExistingDirectory);
     CLI11_PARSE(app, argc, argv);
+    if (noPhaseDb) phase.database.path.clear();
     spdlog::set_default_logger(spdlog::stderr_color_mt("leafluxd"));  // a daemon logs to stderr
     if (!logFile.empty()) {
         try {
@@ -127,7 +149,7 @@ int main(int argc, char** argv) {
     std::signal(SIGINT, OnSignal);
     std::signal(SIGTERM, OnSignal);
     zmq::context_t context;
-    Daemon daemon(limits);
+    Daemon daemon(limits, std::move(phase));
     std::unique_ptr<RouterServer> server;
     try {
         server = std::make_unique<RouterServer>(context, bind, transport, curveSecretKey);
@@ -169,6 +191,7 @@ int main(int argc, char** argv) {
         dispatcher.AbandonRunning();
         server->Close(std::chrono::milliseconds(2000));
         if (abandoned > 0) spdlog::warn("leafluxd abandoned {} requests in flight", abandoned);
+        daemon.PhaseFunctions().Flush();
         spdlog::info("leafluxd stopped");
     } catch (const std::exception& e) {
         spdlog::error("leafluxd: {}", e.what());

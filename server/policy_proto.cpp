@@ -38,6 +38,8 @@ Bins BinsFromProto(bool stated, const v1::Bins& bins, const std::string& field) 
     return Bins{std::vector<double>(bins.edges().begin(), bins.edges().end())};
 }
 
+}  // namespace
+
 FunctionResolution ResolutionFromProto(const v1::FunctionResolution& in, const std::string& field) {
     FunctionResolution out;
     switch (in.kind()) {
@@ -74,8 +76,6 @@ FunctionResolution ResolutionFromProto(const v1::FunctionResolution& in, const s
     }
     return out;
 }
-
-}  // namespace
 
 InstancingPolicy PolicyFromProto(const v1::InstancingPolicy& message) {
     if (message.version() > v1::PROTOCOL_VERSION_CURRENT) {

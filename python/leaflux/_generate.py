@@ -77,6 +77,9 @@ def generate(proto_dir: str, out_dir: str) -> list[str]:
             for sibling in siblings:
                 code = re.sub(rf"^import {sibling} as ", f"from . import {sibling} as ", code,
                               flags=re.MULTILINE)
+                # A public import (policy.proto re-exports leaflux.proto's policy messages).
+                code = re.sub(rf"^from {sibling} import \*", f"from .{sibling} import *", code,
+                              flags=re.MULTILINE)
             target = os.path.join(out_dir, name)
             fd, partial = tempfile.mkstemp(prefix=f".{name}.", dir=out_dir)
             with os.fdopen(fd, "w") as f:

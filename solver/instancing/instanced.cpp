@@ -479,6 +479,7 @@ InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& receivers,
     out.stats.originalsComputed = originals.computed;
     out.stats.originalsReused = originals.reused;
     out.stats.originalSeconds = originals.computeSeconds;
+    out.stats.reuseSeconds = originals.reuseSeconds;
     const std::int64_t rays = out.solution.stats.rays;
     clock.Stamp(out.solution.stats);
     out.solution.stats.rays = rays;

@@ -78,6 +78,7 @@ struct InstancedStats {
     std::vector<Problem> problems;
     int originalsComputed = 0, originalsReused = 0;
     double originalSeconds = 0.0;  // computing the missing originals
+    double reuseSeconds = 0.0;     // finding the reused ones (SceneOriginals::reuseSeconds)
     double solveSeconds = 0.0;     // everything else
     std::int64_t peakRssBytes = 0;
 };

@@ -214,6 +214,16 @@ PhaseFileStats PhaseDatabase::FileStats() {
     return OpenStore().Stats();
 }
 
+void PhaseDatabase::Flush() {
+    std::lock_guard storeLock(storeMutex_);
+    if (!store_ || !store_->Writable()) return;
+    try {
+        store_->Checkpoint();
+    } catch (const SqliteError& e) {
+        NoteError(&PhaseDatabaseStats::writeErrors, e.what());
+    }
+}
+
 void PhaseDatabase::Compact() {
     std::lock_guard storeLock(storeMutex_);
     OpenStore().Compact();

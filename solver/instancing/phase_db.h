@@ -84,6 +84,9 @@ class PhaseDatabase {
     PhaseVerifyReport Verify();
     PhaseFileStats FileStats();
     void Compact();
+    // Every row committed so far written into the file itself (its WAL checkpointed), as
+    // before a process exits; waits for a write in progress. A failure is kept in Health().
+    void Flush();
 
     PhaseDatabaseStats Stats() const;
     // "" when the file is open and every write so far succeeded; else what went wrong,

@@ -290,8 +290,10 @@ PhaseVerifyReport PhaseStore::Verify() {
     return report;
 }
 
+void PhaseStore::Checkpoint() { connection_->Execute("PRAGMA wal_checkpoint(TRUNCATE)"); }
+
 void PhaseStore::Compact() {
-    connection_->Execute("PRAGMA wal_checkpoint(TRUNCATE)");
+    Checkpoint();
     connection_->Execute("VACUUM");
 }
 

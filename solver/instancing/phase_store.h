@@ -100,6 +100,8 @@ class PhaseStore {
     std::vector<PhaseRowInfo> List();
     // PRAGMA integrity_check and every row's checksum and blob.
     PhaseVerifyReport Verify();
+    // Moves the WAL's committed rows into the file and empties the WAL.
+    void Checkpoint();
     // Checkpoints the WAL and VACUUMs: the file shrinks to its rows.
     void Compact();
     PhaseFileStats Stats();

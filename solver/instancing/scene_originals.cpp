@@ -55,6 +55,7 @@ SceneOriginals OriginalsOf(const Scene& scene, const SceneSignatures& signatures
             own.method = PhaseMethod::kPhotons;
         const PhaseKey key = KeyOf(policy.species, policy, group.signature, scene, own);
         double seconds = 0.0;
+        const auto asked = std::chrono::steady_clock::now();
         const PhaseLookup lookup = database.GetOrCompute(key, [&] {
             const auto start = std::chrono::steady_clock::now();
             Original original = ComputeOriginal(StructureAlone(scene, group.representative), own);
@@ -67,6 +68,10 @@ SceneOriginals OriginalsOf(const Scene& scene, const SceneSignatures& signatures
         originals.computed += computed;
         originals.reused += !computed;
         originals.computeSeconds += seconds;
+        if (!computed) {
+            originals.reuseSeconds +=
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
+        }
         originals.bySignature[group.signature] = lookup.original;
     }
     return originals;

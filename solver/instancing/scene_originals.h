@@ -31,6 +31,9 @@ struct SceneOriginals {
     int computed = 0;  // missing from the database (or a bad row), computed now
     int reused = 0;    // from memory or the file, or computed meanwhile by another caller
     double computeSeconds = 0.0;  // spent computing the missing ones
+    // Spent finding the others: reading them from the file, or awaiting another caller's
+    // computation of them.
+    double reuseSeconds = 0.0;
 };
 
 SceneOriginals OriginalsOf(const Scene& scene, const SceneSignatures& signatures,
