@@ -8,12 +8,14 @@
 
 #include "growth_stub/run.h"
 #include "server/cli_checks.h"
+#include "server/text_format.h"
 
 int main(int argc, char** argv) {
     using namespace leaflux;
     CLI::App app{"leaflux-grow: the reference growth model, a client of leafluxd"};
     app.option_defaults()->always_capture_default();  // --help shows every default
-    std::string scenarioPath, endpoint = "tcp://127.0.0.1:5555", curveKeyFile, solver, pictures;
+    std::string scenarioPath, endpoint = "tcp://127.0.0.1:5555", curveKeyFile, solver, pictures,
+                              policyFile;
     grow::RunOptions options;
     int cycles = 0;
     double epsilon = 0.0, spacing = 0.0, rowAzimuth = -1.0;
@@ -37,8 +39,15 @@ int main(int argc, char** argv) {
                    "File with leafluxd's CurveZMQ public key (when it has one)")
         ->check(CLI::ExistingFile);
     app.add_option("--solver", solver,
-                   "Override the scenario's solver: hrc or mc (empty: the scenario's)")
-        ->check(CLI::IsMember({"hrc", "mc"}));
+                   "Override the scenario's solver: hrc, mc or instanced (hierarchical "
+                   "instantiation, its phase functions kept in leafluxd's database; empty: the "
+                   "scenario's)")
+        ->check(CLI::IsMember({"hrc", "mc", "instanced"}));
+    app.add_option("--policy", policyFile,
+                   "With --solver instanced: the instantiation policy file to send (protobuf "
+                   "text format, leaflux.v1.InstancingPolicy; default: the daemon's for the "
+                   "scenario's species, else its built-in one)")
+        ->check(CLI::ExistingFile);
     app.add_option("--epsilon", epsilon, "Override the scenario's HRC ε (0: the scenario's)")
         ->check(CLI::Range(0.0, 1.0));
     app.add_option("--samples", samples,
@@ -49,7 +58,8 @@ int main(int argc, char** argv) {
     app.add_flag("--direct-only", directOnly,
                  "Light straight from the sources only, no scattering (paper Fig. 19)");
     app.add_flag("--branch-light", options.branchLight,
-                 "Ask for per-axis light only; each leaf gets its axis's");
+                 "Ask for per-axis light only; each leaf gets its axis's (with --solver "
+                 "instanced, instances are opened down to axes only)");
     app.add_option("--spacing", spacing,
                    "Override the stand's spacing within rows (m; 0: the scenario's); "
                    "refused for a scenario without a stand")
@@ -83,6 +93,17 @@ int main(int argc, char** argv) {
         v1::SolverSettings& settings = *scenario.mutable_settings();
         if (solver == "hrc") settings.set_solver(v1::SOLVER_KIND_HRC);
         if (solver == "mc") settings.set_solver(v1::SOLVER_KIND_MONTE_CARLO);
+        if (solver == "instanced") settings.set_solver(v1::SOLVER_KIND_INSTANCED);
+        const bool instanced = settings.solver() == v1::SOLVER_KIND_INSTANCED;
+        if (!policyFile.empty()) {
+            if (!instanced)
+                throw std::invalid_argument("--policy: only the instanced solver takes a policy");
+            if (const auto error = ReadTextFormat(
+                    policyFile, *settings.mutable_instanced()->mutable_inline_policy()))
+                throw std::invalid_argument(error->where + ": " + error->what);
+        }
+        if (instanced && options.branchLight)
+            settings.mutable_instanced()->set_output_level(v1::NODE_TYPE_AXIS);
         if (epsilon > 0.0) settings.set_epsilon(epsilon);
         if (samples > 0) settings.set_samples(samples);
         if (directOnly) settings.set_direct_only(true);

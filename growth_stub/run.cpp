@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -41,9 +42,12 @@ LeafLight FromBand(const v1::BandLight& b) {
 
 // The PAR of every leaf: its own, or with branch-level light its axis's mean irradiance
 // and light vector, and its axis's absorbed power per m² times its area (stems included:
-// a coarser answer, for models that only need it).
+// a coarser answer, for models that only need it). An axis the instanced solver solved
+// whole has no irradiance of its own (NaN): its leaves' is then what they absorb over
+// `leafAbsorptance`.
 std::map<NodeId, LeafLight> LeafLightOf(const v1::CycleResult& result, const GrowthModel& model,
-                                        const std::string& band, bool branchLight) {
+                                        const std::string& band, bool branchLight,
+                                        double leafAbsorptance) {
     std::unordered_map<NodeId, LeafLight> byNode;
     if (branchLight) {
         for (const v1::StructureLight& s : result.structures()) {
@@ -51,6 +55,8 @@ std::map<NodeId, LeafLight> LeafLightOf(const v1::CycleResult& result, const Gro
             if (s.type() != v1::NODE_TYPE_AXIS || !b || s.area_m2() <= 0.0) continue;
             LeafLight perM2 = FromBand(*b);
             perM2.absorbedW /= s.area_m2();
+            if (std::isnan(perM2.irradianceWm2))
+                perM2.irradianceWm2 = perM2.absorbedW / std::max(leafAbsorptance, 1e-6);
             byNode[s.node()] = perM2;
         }
     } else {
@@ -164,8 +170,21 @@ std::set<int> CycleList(const std::string& list, const std::string& option) {
     return cycles;
 }
 
+// The mean over both sides of what the leaves absorb of the light reaching them, in `band`.
+double LeafAbsorptance(const Scenario& scenario, const std::string& band) {
+    for (const v1::Optics& optics : scenario.scene().optics()) {
+        if (optics.id() != scenario.leaf_optics()) continue;
+        const auto it = optics.bands().find(band);
+        if (it == optics.bands().end()) break;
+        const v1::BandOptics& b = it->second;
+        return 1.0 - 0.5 * (b.rho_upper() + b.rho_lower() + b.tau_upper() + b.tau_lower());
+    }
+    return 1.0;
+}
+
 std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
                              const RunOptions& options, Client& client) {
+    const double absorptance = LeafAbsorptance(scenario, scenario.par_band());
     v1::OpenSession open;
     *open.mutable_scene() = SessionScene(scenario, model, {});
     *open.mutable_settings() = scenario.settings();
@@ -179,7 +198,8 @@ std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
         plantsCsv.open(options.outDir + "/plants.csv");
         phytomersCsv.open(options.outDir + "/phytomers.csv");
         cyclesCsv << "cycle,leaves,leaf_area_m2,biomass_g,absorbed_par_w,added,updated,removed,"
-                     "solve_s,round_trip_s,daemon_peak_mib\n";
+                     "solve_s,round_trip_s,daemon_peak_mib,phase_computed,phase_reused,"
+                     "phase_compute_s\n";
         plantsCsv << "cycle,plant,leaves,leaf_area_m2,biomass_g,absorbed_par_w,centroid_x,"
                      "centroid_y,centroid_z\n";
         phytomersCsv << "cycle,address,internode_g,leaf_g\n";
@@ -205,11 +225,12 @@ std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
             *resync.mutable_scene() = SessionScene(scenario, model, sent);
             *resync.mutable_settings() = scenario.settings();
             resync.set_last_cycle(c - 1);
+            resync.set_species(scenario.name());
             return resync;
         });
         sent = nodes;
         const std::map<NodeId, LeafLight> light =
-            LeafLightOf(result, model, scenario.par_band(), options.branchLight);
+            LeafLightOf(result, model, scenario.par_band(), options.branchLight, absorptance);
 
         CycleRecord record;
         record.cycle = c;
@@ -220,6 +241,9 @@ std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         record.solveSeconds = result.statistics().wall_seconds();
         record.daemonPeakMib = result.statistics().peak_rss_bytes() / 1048576.0;
+        record.phaseComputed = result.statistics().phase_functions_computed();
+        record.phaseReused = result.statistics().phase_functions_reused();
+        record.phaseComputeSeconds = result.statistics().phase_compute_seconds();
         // The rows and pictures tell the plants as they were lit; then they grow.
         record.plants = model.Summaries();
         std::map<NodeId, PlantSummary*> byPlant;
@@ -237,7 +261,9 @@ std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
             cyclesCsv << c << ',' << record.leaves << ',' << record.leafAreaM2 << ','
                       << record.biomassG << ',' << record.absorbedParW << ',' << record.added << ','
                       << record.updated << ',' << record.removed << ',' << record.solveSeconds
-                      << ',' << record.roundTripSeconds << ',' << record.daemonPeakMib << '\n';
+                      << ',' << record.roundTripSeconds << ',' << record.daemonPeakMib << ','
+                      << record.phaseComputed << ',' << record.phaseReused << ','
+                      << record.phaseComputeSeconds << '\n';
             for (const PlantSummary& plant : record.plants) {
                 plantsCsv << c << ',' << plant.id << ',' << plant.leaves << ',' << plant.leafAreaM2
                           << ',' << plant.biomassG << ',' << plant.absorbedParW << ','

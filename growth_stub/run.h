@@ -27,6 +27,10 @@ struct CycleRecord {
     double leafAreaM2 = 0.0, biomassG = 0.0, absorbedParW = 0.0;
     int added = 0, updated = 0, removed = 0;
     double solveSeconds = 0.0, roundTripSeconds = 0.0, daemonPeakMib = 0.0;
+    // The instanced solver's phase functions: computed this cycle, reused, and the seconds
+    // computing them took.
+    int phaseComputed = 0, phaseReused = 0;
+    double phaseComputeSeconds = 0.0;
     std::vector<PlantSummary> plants;
 };
 
