@@ -2,8 +2,10 @@
 # The main job: starts leafluxd, grows the `wall-hole` plant (a plant in a room lit only
 # through a hole in a wall) for 25 cycles with leaflux-grow, writes its CSVs, the PLY and
 # pictures of cycles 2, 9, 13, 17 and 25 and a growth plot, grows it again with direct
-# light only and compares the two plants organ by organ, then stops the daemon cleanly;
-# all in out/demo/.
+# light only, with instancing (the instanced solver; its phase functions kept in the
+# daemon's database, by default under ~/.local/share/leaflux) and with instancing limited to
+# structures of more than 10 leaves, compares each with the first plant organ by organ
+# (paper Fig. 19 and 15), then stops the daemon cleanly; all in out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -41,6 +43,15 @@ start_daemon
 "$B/growth_stub/leaflux-grow" --scenario growth_stub/scenarios/wall-hole.txtpb --cycles 25 \
     --endpoint "$endpoint" --out "$out/direct_only" --direct-only --quiet | tee -a "$out/grow.txt"
 stop_daemon
+start_daemon
+"$B/growth_stub/leaflux-grow" --scenario growth_stub/scenarios/wall-hole.txtpb --cycles 25 \
+    --endpoint "$endpoint" --out "$out/instanced" --solver instanced --quiet | tee -a "$out/grow.txt"
+stop_daemon
+start_daemon
+"$B/growth_stub/leaflux-grow" --scenario growth_stub/scenarios/wall-hole.txtpb --cycles 25 \
+    --endpoint "$endpoint" --out "$out/instanced_above_10" --solver instanced \
+    --policy proto/policies/above_10_leaves.txtpb --quiet | tee -a "$out/grow.txt"
+stop_daemon
 
 for c in 2 9 13 17 25; do
     /usr/bin/python3 examples/render_ply.py "$out/cycle$c.ply" "$out/cycle$c.png" "wall-hole, cycle $c"
@@ -48,5 +59,11 @@ done
 /usr/bin/python3 examples/plot_growth.py "$out" "full light" "$out/direct_only" "direct light only"
 /usr/bin/python3 examples/compare_growth.py "$out" full "$out/direct_only" direct_only \
     "$out/growth_comparison"
+/usr/bin/python3 examples/compare_growth.py "$out" hrc "$out/instanced" instanced \
+    "$out/instancing_comparison"
+/usr/bin/python3 examples/compare_growth.py "$out" hrc "$out/instanced_above_10" \
+    instanced_above_10_leaves "$out/instancing_above_10_comparison"
 echo "results in $out/: cycles.csv plants.csv phytomers.csv cycle{2,9,13,17,25}.{ply,png}" \
-     "growth.png growth_comparison.{csv,png} grow.txt direct_only/ leafluxd.log"
+     "growth.png growth_comparison.{csv,png} instancing_comparison.{csv,png}" \
+     "instancing_above_10_comparison.{csv,png} grow.txt direct_only/ instanced/" \
+     "instanced_above_10/ leafluxd.log"
