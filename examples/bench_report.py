@@ -8,7 +8,7 @@ between its `<!-- report:NAME -->` and `<!-- /report:NAME -->` markers, so that 
 what the last run measured and nothing else: docs/results.md holds every table (one section
 per scene), README.md one summary of the error tables (`report:summary`).
 
-Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability]
+Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon]
                       [--scenes a,b]
                       [--scaling-solvers hrc,mc]
        bench_report.py --tables-only [--only ...]   # rewrite from examples/report/, run nothing
@@ -174,7 +174,12 @@ def scaling_section(build, out, solvers, run=True):
 DEMO_FILES = [("growth_comparison.csv", "growth_comparison.csv"), ("growth_comparison.png", "growth_comparison.png"),
               ("cycles.csv", "demo_cycles_full.csv"), ("direct_only/cycles.csv", "demo_cycles_direct_only.csv"),
               ("plants.csv", "demo_plants_full.csv"), ("direct_only/plants.csv", "demo_plants_direct_only.csv"),
-              ("growth.png", "demo_growth.png")]
+              ("growth.png", "demo_growth.png"),
+              ("instancing_comparison.csv", "instancing_comparison.csv"),
+              ("instancing_comparison.png", "instancing_comparison.png"),
+              ("instancing_above_10_comparison.csv", "instancing_above_10_comparison.csv"),
+              ("instanced/cycles.csv", "demo_cycles_instanced.csv"),
+              ("instanced_above_10/cycles.csv", "demo_cycles_instanced_above_10.csv")]
 
 
 def growth_section(demo, run=True):
@@ -193,6 +198,57 @@ def growth_section(demo, run=True):
                          f"{r['leaf_distance_pct']} | {number(r['solve_s_full'])} / "
                          f"{number(r['solve_s_direct_only'])} | {number(r['daemon_peak_mib_full'])} / "
                          f"{number(r['daemon_peak_mib_direct_only'])} |")
+    return "\n".join(table)
+
+
+def instancing_section():
+    """The demo's plant grown with HRC against the one grown with instancing, and with
+    instancing of structures of more than 10 leaves (paper Fig. 15), every 5 cycles."""
+    every = list(csv.DictReader(open(os.path.join(REPORT, "instancing_comparison.csv"))))
+    above = {r["cycle"]: r for r in csv.DictReader(open(os.path.join(REPORT, "instancing_above_10_comparison.csv")))}
+    runs = {run: {r["cycle"]: r for r in csv.DictReader(open(os.path.join(REPORT, f"demo_cycles_{run}.csv")))}
+            for run in ("instanced", "instanced_above_10")}
+    table = [f"![instancing comparison]({figure(RESULTS, 'instancing_comparison.png')})", "",
+             "| cycle | phytomers | distance % to HRC: instanced / above 10 leaves | solve s HRC / instanced / "
+             "above 10 | phase functions computed so far: instanced / above 10 |", "|---|---|---|---|---|"]
+    computed = {run: 0 for run in runs}
+    for r in every:
+        c = r["cycle"]
+        for run in runs:
+            computed[run] += int(runs[run][c]["phase_computed"])
+        if int(c) % 5 == 0:
+            a = above[c]
+            table.append(f"| {c} | {r['phytomers_hrc']} | {r['structural_distance_pct']} / "
+                         f"{a['structural_distance_pct']} | {number(r['solve_s_hrc'])} / "
+                         f"{number(r['solve_s_instanced'])} / {number(a['solve_s_instanced_above_10_leaves'])} | "
+                         f"{computed['instanced']} / {computed['instanced_above_10']} |")
+    return "\n".join(table)
+
+
+def daemon_section(build, out, run=True):
+    """Runs leaflux_bench_daemon: the median solve of a cycle of the growing plants, by solver,
+    database and ε."""
+    if run:
+        os.makedirs(out, exist_ok=True)
+        subprocess.run([os.path.join(build, "tests", "leaflux_bench_daemon"),
+                        os.path.join(out, "daemon_bench.csv")], check=True)
+        shutil.copy(os.path.join(out, "daemon_bench.csv"), os.path.join(REPORT, "daemon_bench.csv"))
+    rows = list(csv.DictReader(open(os.path.join(REPORT, "daemon_bench.csv"))))
+    names = {"growing_tree": "HRC", "instanced_cold": "instanced, empty database",
+             "instanced_warm": "instanced, the database filled"}
+    table = ["| solver | leaves | ε | median solve ms (10 cycles) | last cycle ms | phase functions computed |",
+             "|---|---|---|---|---|---|"]
+    keys = []
+    for r in rows:
+        key = (r["what"], r["leaves"], r["epsilon"])
+        if r["what"] in names and key not in keys:
+            keys.append(key)
+    for what, leaves, epsilon in sorted(keys, key=lambda k: (int(k[1]), float(k[2]), list(names).index(k[0]))):
+        cycle = [r for r in rows if (r["what"], r["leaves"], r["epsilon"]) == (what, leaves, epsilon)]
+        times = sorted(float(r["solve_ms"]) for r in cycle)
+        median = 0.5 * (times[(len(times) - 1) // 2] + times[len(times) // 2])
+        table.append(f"| {names[what]} | {int(leaves):,} | {float(epsilon):.0e} | {number(median)} | "
+                     f"{number(cycle[-1]['solve_ms'])} | {sum(int(r['phase_computed']) for r in cycle)} |")
     return "\n".join(table)
 
 
@@ -422,7 +478,7 @@ def main():
                         help="build directory (default: build/release)")
     parser.add_argument("out", nargs="?", default=os.path.join(ROOT, "out", "report"),
                         help="directory of the runs' files (default: out/report)")
-    parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability",
+    parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon",
                         help="parts to run (default: all)")
     parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
     parser.add_argument("--scaling-solvers", default="hrc,mc",
@@ -455,6 +511,9 @@ def main():
     if "growth" in parts:
         update(RESULTS, "growth", growth_section(args.demo, run))
         update(RESULTS, "demo", demo_section())
+        update(RESULTS, "growth-instanced", instancing_section())
+    if "daemon" in parts:
+        update(RESULTS, "daemon", daemon_section(build, os.path.join(out, "daemon"), run))
     if "phase-db" in parts:
         update(RESULTS, "phase-db", phase_db_section(build, os.path.join(out, "phase"), run))
     if "phase-spread" in parts:

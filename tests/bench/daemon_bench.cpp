@@ -2,7 +2,10 @@
 // empty delta, answered with the last cycle's light — with the organs' results or none —
 // or solved again when it asks other outputs) and the latency of cycles of a plant growing to
 // 1,000 leaves (HRC, ε = 1e-4, 3e-4 and 1e-3) and 10,000 leaves (ε = 1e-4 and 3e-4), one
-// tenth of the plant added per cycle.
+// tenth of the plant added per cycle; and the same plants with the instanced solver
+// (ε = 1e-4 and 3e-4), first on a new daemon's empty phase-function database (cold: the
+// functions computed as the plant's structures appear), then as a second session on the
+// database the first filled (warm: none computed).
 // Run: build/release/tests/leaflux_bench_daemon [out.csv, default out/bench/daemon_bench.csv]
 #include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
@@ -87,6 +90,7 @@ struct Row {
     double epsilon;
     int cycle, organs;
     double roundTripMs, solveMs;
+    int phaseComputed = 0;
 };
 
 }  // namespace
@@ -108,14 +112,17 @@ int main(int argc, char** argv) {
         for (int i = 0; i < kCalls; ++i) daemon.Call(status);
         rows.push_back({"status", 0, 0.0, 0, 0, 1e3 * Seconds(start) / kCalls, 0.0});
     }
-    for (const auto& [leaves, epsilon] :
-         {std::pair{1000, 1e-4}, {1000, 3e-4}, {1000, 1e-3}, {10000, 1e-4}, {10000, 3e-4}}) {
+    // Grows the tree of `leaves` in a session of `settings` over kCycles cycles; returns
+    // the session.
+    constexpr int kCycles = 10;
+    auto grow = [&](Loopback& daemon, const char* what, int leaves,
+                    const v1::SolverSettings& settings) {
         std::vector<v1::Node> nodes;
         v1::Request open;
         *open.mutable_open_session()->mutable_scene() = TreeScene(leaves, nodes);
-        open.mutable_open_session()->mutable_settings()->set_epsilon(epsilon);
+        *open.mutable_open_session()->mutable_settings() = settings;
+        open.mutable_open_session()->set_species("generated-tree");
         const std::string session = daemon.Call(open).opened().session();
-        constexpr int kCycles = 10;
         std::size_t next = 0;
         for (int c = 1; c <= kCycles; ++c) {
             v1::Request request;
@@ -127,9 +134,18 @@ int main(int argc, char** argv) {
             for (; next < until; ++next) *cycle->mutable_delta()->add_added() = nodes[next];
             const auto start = Clock::now();
             const v1::Reply reply = daemon.Call(request);
-            rows.push_back({"growing_tree", leaves, epsilon, c, reply.cycle().organs_size(),
-                            1e3 * Seconds(start), 1e3 * reply.cycle().statistics().wall_seconds()});
+            const v1::SolveStatistics& stats = reply.cycle().statistics();
+            rows.push_back({what, leaves, settings.epsilon(), c, reply.cycle().organs_size(),
+                            1e3 * Seconds(start), 1e3 * stats.wall_seconds(),
+                            stats.phase_functions_computed()});
         }
+        return session;
+    };
+    for (const auto& [leaves, epsilon] :
+         {std::pair{1000, 1e-4}, {1000, 3e-4}, {1000, 1e-3}, {10000, 1e-4}, {10000, 3e-4}}) {
+        v1::SolverSettings settings;
+        settings.set_epsilon(epsilon);
+        const std::string session = grow(daemon, "growing_tree", leaves, settings);
         // The same plant again with nothing changed. Asking what the last cycle asked, its
         // light comes back unsolved: the protocol alone and the organs' results (median of
         // kRepeats calls). Asking other outputs (none), it is solved again: validation,
@@ -158,19 +174,29 @@ int main(int argc, char** argv) {
         unchanged(false, 1, "empty_resolve");
         unchanged(false, kRepeats, "empty_nothing");
     }
+    for (const auto& [leaves, epsilon] :
+         {std::pair{1000, 1e-4}, {1000, 3e-4}, {10000, 1e-4}, {10000, 3e-4}}) {
+        v1::SolverSettings settings;
+        settings.set_solver(v1::SOLVER_KIND_INSTANCED);
+        settings.set_epsilon(epsilon);
+        Loopback fresh;  // its database empty
+        grow(fresh, "instanced_cold", leaves, settings);
+        grow(fresh, "instanced_warm", leaves, settings);
+    }
     const char* path = argc > 1 ? argv[1] : "out/bench/daemon_bench.csv";
     if (const auto folder = std::filesystem::path(path).parent_path(); !folder.empty())
         std::filesystem::create_directories(folder);  // out/ from the checkout root
     std::ofstream csv(path);
-    csv << "what,leaves,epsilon,cycle,organs,round_trip_ms,solve_ms,overhead_ms\n";
-    std::printf("%-14s %7s %8s %6s %7s %14s %10s %12s\n", "what", "leaves", "epsilon", "cycle",
-                "organs", "round_trip_ms", "solve_ms", "overhead_ms");
+    csv << "what,leaves,epsilon,cycle,organs,round_trip_ms,solve_ms,overhead_ms,phase_computed\n";
+    std::printf("%-14s %7s %8s %6s %7s %14s %10s %12s %6s\n", "what", "leaves", "epsilon", "cycle",
+                "organs", "round_trip_ms", "solve_ms", "overhead_ms", "phases");
     for (const Row& r : rows) {
         csv << r.what << ',' << r.leaves << ',' << r.epsilon << ',' << r.cycle << ',' << r.organs
-            << ',' << r.roundTripMs << ',' << r.solveMs << ',' << r.roundTripMs - r.solveMs << '\n';
-        std::printf("%-14s %7d %8.0e %6d %7d %14.3f %10.3f %12.3f\n", r.what.c_str(), r.leaves,
+            << ',' << r.roundTripMs << ',' << r.solveMs << ',' << r.roundTripMs - r.solveMs << ','
+            << r.phaseComputed << '\n';
+        std::printf("%-14s %7d %8.0e %6d %7d %14.3f %10.3f %12.3f %6d\n", r.what.c_str(), r.leaves,
                     r.epsilon, r.cycle, r.organs, r.roundTripMs, r.solveMs,
-                    r.roundTripMs - r.solveMs);
+                    r.roundTripMs - r.solveMs, r.phaseComputed);
     }
     std::printf("wrote %s\n", path);
     return 0;
