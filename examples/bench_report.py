@@ -209,8 +209,9 @@ def instancing_section():
     runs = {run: {r["cycle"]: r for r in csv.DictReader(open(os.path.join(REPORT, f"demo_cycles_{run}.csv")))}
             for run in ("instanced", "instanced_above_10")}
     table = [f"![instancing comparison]({figure(RESULTS, 'instancing_comparison.png')})", "",
-             "| cycle | phytomers | distance % to HRC: instanced / above 10 leaves | solve s HRC / instanced / "
-             "above 10 | phase functions computed so far: instanced / above 10 |", "|---|---|---|---|---|"]
+             "| cycle | phytomers | distance % to HRC: instanced / above 10 leaves | per phytomer, max / σ %: "
+             "instanced / above 10 | solve s HRC / instanced / above 10 | phase functions computed so far: "
+             "instanced / above 10 |", "|---|---|---|---|---|---|"]
     computed = {run: 0 for run in runs}
     for r in every:
         c = r["cycle"]
@@ -219,7 +220,9 @@ def instancing_section():
         if int(c) % 5 == 0:
             a = above[c]
             table.append(f"| {c} | {r['phytomers_hrc']} | {r['structural_distance_pct']} / "
-                         f"{a['structural_distance_pct']} | {number(r['solve_s_hrc'])} / "
+                         f"{a['structural_distance_pct']} | {number(r['phytomer_distance_max_pct'])} / "
+                         f"{number(r['phytomer_distance_sd_pct'])}, {number(a['phytomer_distance_max_pct'])} / "
+                         f"{number(a['phytomer_distance_sd_pct'])} | {number(r['solve_s_hrc'])} / "
                          f"{number(r['solve_s_instanced'])} / {number(a['solve_s_instanced_above_10_leaves'])} | "
                          f"{computed['instanced']} / {computed['instanced_above_10']} |")
     return "\n".join(table)

@@ -7,7 +7,9 @@ Phytomers are matched by their topological address (plant, axis path, rank: the 
 both runs however the node ids differ). The structural distance is the organ-by-organ
 difference of mass, Σ |m_a − m_b| over every address (a phytomer one run lacks has mass 0
 there), in % of the mean total mass ½ Σ (m_a + m_b): 0 for identical plants, 200 % for
-plants sharing no organ.
+plants sharing no organ. Per phytomer, the relative difference of its mass between the runs,
+|m_a − m_b| / ½ (m_a + m_b), gives the distance's largest value and standard deviation over
+the phytomers (paper Fig. 15: max and σ), a phytomer one run lacks counting 200 %.
 
 Usage: compare_growth.py RUN_A LABEL_A RUN_B LABEL_B OUT_PREFIX
 Writes OUT_PREFIX.csv and OUT_PREFIX.png.
@@ -43,6 +45,18 @@ def distance(a, b):
     return total, leaves, len(a.keys() ^ b.keys())
 
 
+def per_phytomer(a, b):
+    """(largest, standard deviation) over phytomers of their masses' relative difference, %."""
+    values = []
+    for k in a.keys() | b.keys():
+        ma, mb = sum(a.get(k, (0, 0))), sum(b.get(k, (0, 0)))
+        values.append(200 * abs(ma - mb) / (ma + mb) if ma + mb > 0 else 0.0)
+    if not values:
+        return 0.0, 0.0
+    mean = sum(values) / len(values)
+    return max(values), (sum((v - mean) ** 2 for v in values) / len(values)) ** 0.5
+
+
 def main():
     parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     parser.add_argument("run_a", help="the first run's folder (leaflux-grow --out)")
@@ -57,7 +71,9 @@ def main():
     rows = []
     for c in sorted(pa.keys() & pb.keys()):
         total, leaves, unmatched = distance(pa[c], pb[c])
+        largest, sigma = per_phytomer(pa[c], pb[c])
         rows.append(dict(cycle=c, structural_distance_pct=round(total, 3), leaf_distance_pct=round(leaves, 3),
+                         phytomer_distance_max_pct=round(largest, 3), phytomer_distance_sd_pct=round(sigma, 3),
                          phytomers_in_one_run=unmatched,
                          **{f"phytomers_{label}": len(p[c]) for label, p in ((label_a, pa), (label_b, pb))},
                          **{f"solve_s_{label}": cc[c]["solve_s"] for label, cc in ((label_a, ca), (label_b, cb))},
@@ -83,6 +99,8 @@ def main():
     fig, axes = plt.subplots(1, 3, figsize=(14, 3.8))
     axes[0].plot(x, [r["structural_distance_pct"] for r in rows], marker=".", label="all organs")
     axes[0].plot(x, [r["leaf_distance_pct"] for r in rows], marker=".", label="leaves")
+    axes[0].plot(x, [r["phytomer_distance_max_pct"] for r in rows], ls="--", label="phytomers: max")
+    axes[0].plot(x, [r["phytomer_distance_sd_pct"] for r in rows], ls=":", label="phytomers: σ")
     axes[0].set_ylabel(f"distance, {label_a} vs {label_b} (%)")
     axes[0].legend()
     for label in (label_a, label_b):
