@@ -8,6 +8,7 @@
 #include <random>
 
 #include "server/executor.h"
+#include "solver/scene/light_units.h"
 #include "solver/util/error.h"
 
 namespace leaflux {
@@ -113,6 +114,11 @@ void BandsToProto(const Scene& scene, const std::vector<BandLight>& bands,
         }
         band->set_stderr_upper_wm2(light.stderrUpperWm2);
         band->set_stderr_lower_wm2(light.stderrLowerWm2);
+        if (const std::optional<double> photons = PhotonUmolPerJ(scene.bands[b])) {
+            band->set_photon_irradiance_upper_umol_m2_s(*photons * light.irradianceUpperWm2);
+            band->set_photon_irradiance_lower_umol_m2_s(*photons * light.irradianceLowerWm2);
+            band->set_absorbed_umol_s(*photons * light.absorbedW);
+        }
     }
 }
 

@@ -706,6 +706,39 @@ TEST(DaemonOutputs, LightVectorsOnlyWhenAsked) {
     EXPECT_GT(with.cycle().organs(0).bands(0).light_vector().z(), 0.5);  // the sun is above
 }
 
+// PAR comes in photons beside W/m²: 4.57 µmol/J for a PAR band that gives no factor, the
+// band's own factor when it gives one, and none for a band without a photon unit.
+TEST(DaemonOutputs, PhotonUnitsComeWithEachBandThatHasOne) {
+    for (const auto& [name, factor, want] :
+         {std::tuple{"PAR", 0.0, 4.57}, {"PAR", 4.2, 4.2}, {"NIR", 0.0, 0.0}}) {
+        v1::Request open = OpenRequest();
+        v1::Scene* scene = open.mutable_open_session()->mutable_scene();
+        scene->mutable_bands(0)->set_name(name);
+        scene->mutable_bands(0)->set_photon_umol_per_j(factor);
+        v1::Optics* optics = scene->mutable_optics(0);
+        (*optics->mutable_bands())[name] = optics->bands().at("PAR");
+        if (std::string(name) != "PAR") optics->mutable_bands()->erase("PAR");
+        v1::Sun* sun = scene->mutable_suns(0);
+        (*sun->mutable_normal_irradiance())[name] = 400.0;
+        if (std::string(name) != "PAR") sun->mutable_normal_irradiance()->erase("PAR");
+        Daemon daemon;
+        const v1::Reply opened = daemon.Handle(open);
+        ASSERT_TRUE(opened.has_opened()) << opened.DebugString();
+        const v1::Reply reply = daemon.Handle(CycleRequest(opened.opened().session(), 1));
+        ASSERT_TRUE(reply.has_cycle()) << reply.DebugString();
+        const v1::BandLight& b = reply.cycle().organs(0).bands(0);
+        ASSERT_GT(b.irradiance_upper_wm2(), 0.0);
+        if (want == 0.0) {
+            EXPECT_FALSE(b.has_photon_irradiance_upper_umol_m2_s()) << name;
+            EXPECT_FALSE(b.has_absorbed_umol_s());
+            continue;
+        }
+        EXPECT_DOUBLE_EQ(b.photon_irradiance_upper_umol_m2_s(), want * b.irradiance_upper_wm2());
+        EXPECT_DOUBLE_EQ(b.photon_irradiance_lower_umol_m2_s(), want * b.irradiance_lower_wm2());
+        EXPECT_DOUBLE_EQ(b.absorbed_umol_s(), want * b.absorbed_w());
+    }
+}
+
 // --solver-threads caps the cores of every solve; a session asking fewer gets fewer.
 TEST(DaemonThreads, SolvesUseAtMostTheDaemonsSolverThreads) {
     for (const auto& [limit, asked, used] : {std::tuple{1, 0, 1}, {1, 2, 1}, {2, 1, 1}}) {
