@@ -16,8 +16,8 @@ auto Under(const std::string& prefix, Read read) {
     try {
         return read();
     } catch (const InputError& e) {
-        throw InputError(e.Code(), e.Field().empty() ? prefix : prefix + "." + e.Field(), e.what(),
-                         e.Node());
+        throw InputError(e.Code(), e.Field().empty() ? prefix : prefix + "." + e.Field(),
+                         e.Message(), e.Node());
     }
 }
 

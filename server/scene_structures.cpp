@@ -38,8 +38,7 @@ ParsedStructure Parse(const std::string& name, const v1::Structure& message,
             parsed.nodes.push_back(NodeFromProto(in, meshes));
         } catch (const InputError& e) {
             throw InputError(e.Code(), field + ".nodes." + e.Field(),
-                             std::string(e.what()) + " (local id " + std::to_string(in.id()) + ")",
-                             e.Node());
+                             e.Message() + " (local id " + std::to_string(in.id()) + ")", e.Node());
         }
         if (in.id() == 0) {
             throw InputError(ErrorCode::kInvalidArgument, field + ".nodes.id",

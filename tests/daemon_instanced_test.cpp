@@ -17,6 +17,7 @@
 #include "server/scene_proto.h"
 #include "solver/generate/generator.h"
 #include "solver/instancing/instanced.h"
+#include "solver/util/error.h"
 #include "tests/scene_builders.h"
 
 namespace leaflux {
@@ -297,6 +298,14 @@ TEST(DaemonInstanced, BadInstancedSettingsAreRefusedNamingTheField) {
         const v1::Reply reply = Call(daemon, request);
         ASSERT_TRUE(reply.has_error()) << field;
         EXPECT_EQ(reply.error().field(), field) << reply.error().message();
+        // Described once: a policy's own error, rethrown under the settings, does not carry
+        // its first description ("invalid_argument phase: …") inside the second.
+        const std::string& message = reply.error().message();
+        const std::string said = message.substr(message.find(": ") + 2);
+        for (const ErrorCode code : {ErrorCode::kInvalidArgument, ErrorCode::kNotFound,
+                                     ErrorCode::kUnsupported, ErrorCode::kParse}) {
+            EXPECT_NE(said.rfind(ErrorCodeName(code), 0), 0u) << message;
+        }
     };
     v1::SolverSettings unknown = Instanced();
     unknown.mutable_instanced()->set_policy_name("poplar");

@@ -38,6 +38,7 @@ InputError::InputError(ErrorCode code, std::string field, const std::string& mes
     : std::runtime_error(Describe(code, field, message, node)),
       code_(code),
       field_(std::move(field)),
+      message_(message),
       node_(node) {}
 
 }  // namespace leaflux

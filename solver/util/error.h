@@ -33,10 +33,14 @@ class InputError : public std::runtime_error {
     const std::string& Field() const { return field_; }
     // The botanical node the error concerns, when there is one.
     std::optional<std::uint64_t> Node() const { return node_; }
+    // What is wrong, without the code, field and node that what() puts before it: what an
+    // error rethrown under another field keeps.
+    const std::string& Message() const { return message_; }
 
   private:
     ErrorCode code_;
     std::string field_;
+    std::string message_;
     std::optional<std::uint64_t> node_;
 };
 
