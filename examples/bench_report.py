@@ -228,15 +228,20 @@ def instancing_section():
     return "\n".join(table)
 
 
+def bench_rows(build, out, program, name, run):
+    """Runs tests/PROGRAM writing OUT/NAME (when `run`), keeps a copy in examples/report/ and
+    returns its rows."""
+    if run:
+        os.makedirs(out, exist_ok=True)
+        subprocess.run([os.path.join(build, "tests", program), os.path.join(out, name)], check=True)
+        shutil.copy(os.path.join(out, name), os.path.join(REPORT, name))
+    return list(csv.DictReader(open(os.path.join(REPORT, name))))
+
+
 def daemon_section(build, out, run=True):
     """Runs leaflux_bench_daemon: the median solve of a cycle of the growing plants, by solver,
     database and ε."""
-    if run:
-        os.makedirs(out, exist_ok=True)
-        subprocess.run([os.path.join(build, "tests", "leaflux_bench_daemon"),
-                        os.path.join(out, "daemon_bench.csv")], check=True)
-        shutil.copy(os.path.join(out, "daemon_bench.csv"), os.path.join(REPORT, "daemon_bench.csv"))
-    rows = list(csv.DictReader(open(os.path.join(REPORT, "daemon_bench.csv"))))
+    rows = bench_rows(build, out, "leaflux_bench_daemon", "daemon_bench.csv", run)
     names = {"growing_tree": "HRC", "instanced_cold": "instanced, empty database",
              "instanced_warm": "instanced, the database filled"}
     table = ["| solver | leaves | ε | median solve ms (10 cycles) | last cycle ms | phase functions computed |",
@@ -342,12 +347,7 @@ def problems_section(build, out, run=True):
 def phase_db_section(build, out, run=True):
     """Runs leaflux_bench_phase_db: the database's miss, hit and load times and its size on
     disk against the number of functions it holds."""
-    if run:
-        os.makedirs(out, exist_ok=True)
-        subprocess.run([os.path.join(build, "tests", "leaflux_bench_phase_db"),
-                        os.path.join(out, "phase_db.csv")], check=True)
-        shutil.copy(os.path.join(out, "phase_db.csv"), os.path.join(REPORT, "phase_db.csv"))
-    rows = list(csv.DictReader(open(os.path.join(REPORT, "phase_db.csv"))))
+    rows = bench_rows(build, out, "leaflux_bench_phase_db", "phase_db.csv", run)
     table = ["| function | functions | blob kB | miss + store ms | memory hit µs | disk hit ms | "
              "file MB | compacted MB |", "|---|---|---|---|---|---|---|---|"]
     for r in rows:
