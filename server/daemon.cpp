@@ -63,6 +63,14 @@ std::string Describe(const v1::Request& request) {
     }
 }
 
+// How a session solves, for the log: "" for HRC and Monte Carlo, else the instanced
+// solver's species and where its policy came from.
+std::string DescribeSolver(const SessionSolver& solver) {
+    if (!solver.instanced) return "";
+    return ": instanced, species " + solver.instanced->policy.species + ", policy " +
+           solver.instanced->policySource;
+}
+
 // A session-level unknown id: its own code, so a client knows to resync.
 class UnknownSession : public std::runtime_error {
   public:
@@ -273,7 +281,7 @@ v1::CycleResult Session::Solve(const v1::OutputRequest& outputs) const {
     if (solver_.instanced) {
         InstancedOptions options = solver_.instanced->options;
         options.hrc = settings.hrc;
-        options.hrc.directionalInstances = solver_.instanced->options.hrc.directionalInstances;
+        options.hrc.directionalInstances = !solver_.instanced->singleValue;
         InstancedSolution run =
             SolveInstanced(solved, prepared.Flat(),
                            solver_.instanced->shadowsByGeometry ? &prepared.Rays() : nullptr,
@@ -476,6 +484,7 @@ v1::Reply Daemon::Open(const v1::OpenSession& request) {
     }
     Scene scene = FromProto(request.scene(), "", limits_.scene);
     SessionSolver solver = Settings(request.settings(), request.species());
+    const std::string described = DescribeSolver(solver);
     auto session = std::make_shared<Session>(std::move(scene), MeshesFromProto(request.scene()),
                                              std::move(solver), limits_.scene);
     std::string id;
@@ -492,7 +501,7 @@ v1::Reply Daemon::Open(const v1::OpenSession& request) {
         } while (sessions_.count(id));
         sessions_.emplace(id, std::move(session));
     }
-    spdlog::info("session {} opened", id);
+    spdlog::info("session {} opened{}", id, described);
     v1::Reply reply;
     reply.mutable_opened()->set_session(id);
     return reply;

@@ -91,10 +91,7 @@ InstancedRun InstancedRunFromProto(const v1::InstancedSettings& in, const std::s
             ResolutionFromProto(in.transmittance(), std::string(kField) + ".transmittance");
     }
     if (in.has_phase() || in.has_transmittance())
-        Under(kField, [&] {
-            ValidatePolicy(run.policy);
-            return 0;
-        });
+        Under(kField, [&] { ValidatePolicy(run.policy); });
     if (in.max_depth() < 0 || in.max_depth() > 64) {
         throw InputError(ErrorCode::kInvalidArgument, std::string(kField) + ".max_depth",
                          "must be in [0, 64]");
@@ -119,7 +116,7 @@ InstancedRun InstancedRunFromProto(const v1::InstancedSettings& in, const std::s
                                  "must be NODE_TYPE_PLANT, NODE_TYPE_AXIS or NODE_TYPE_PHYTOMER");
         }
     }
-    run.options.hrc.directionalInstances = !in.single_value();
+    run.singleValue = in.single_value();
     switch (in.shadows()) {
         case v1::INSTANCED_SHADOWS_UNSPECIFIED:
         case v1::INSTANCED_SHADOWS_GEOMETRY:

@@ -16,11 +16,11 @@ struct InstancedRun {
     // Its species the session's (OpenSession.species), else the policy's own: the
     // database keeps the functions of a species apart from the others'.
     InstancingPolicy policy;
-    // All but `hrc`, which the session's solver settings give at each solve
-    // (hrc.directionalInstances is taken from here).
+    // All but `hrc`, which the session's solver settings give at each solve.
     InstancedOptions options;
+    bool singleValue = false;       // HrcOptions::directionalInstances off
     bool shadowsByGeometry = true;  // INSTANCED_SHADOWS_GEOMETRY
-    std::string policySource;       // "inline", "default", or the file read
+    std::string policySource;       // "inline", "default", or the file read: for the log
 };
 
 // Throws InputError naming the field under "settings.instanced" (or the policy file's
