@@ -257,7 +257,7 @@ double CrownHitShare(const PreparedScene& prepared, double half, bool discOnly) 
 // eight 3,000-leaf crowns at ε = 1e-4, the disc's light must be within 0.5 % of E times
 // the gap fraction, and the leaves' within 0.2 % of E times the area they shade. Valued by
 // the judging rays they were −2.37 % and −0.37 % off; −0.11 % and −0.03 % now. The crowns
-// scatter by σ ≈ 0.45 % (disc) and 0.13 % (leaves) from one to the next, so the bounds on
+// scatter by σ ≈ 0.46 % (disc) and 0.14 % (leaves) from one to the next, so the bounds on
 // their mean are 3 and 4 of its standard errors; the grid's own error is below 10⁻⁴.
 TEST(HrcAccuracy, ASunLightsADenseCrownAndTheGroundBeneathAsRaysThroughItFind) {
     const int crowns = 8, leaves = 3000;
