@@ -372,6 +372,9 @@ int RunErrorBench(const ErrorBenchOptions& options) {
     for (Run run : Runs(options)) {
         ResetPeakRss();
         run.settings.instanced.database = &originals;
+        const std::string label = run.solver + " " + run.setting;
+        if (run.solver == "hrc") run.settings.hrc.progress = ProgressBar(label);
+        if (run.solver == "mc") run.settings.monteCarlo.progress = ProgressBar(label);
         const Solution solution = Solve(prepared, run.settings);
         spdlog::info("{} {}: {:.2f} s", run.solver, run.setting, solution.stats.wallSeconds);
         for (Row& row : RowsOf(run, scene, flat, *reference, solution)) rows.push_back(row);

@@ -111,6 +111,7 @@ int RunSolve(const SolveCommand& command) {
             flat.receivers.size(), flat.triangles.size(), scene.bands.size(),
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         settings.monteCarlo.progress = ProgressBar("Monte Carlo");
+        if (settings.kind == SolverKind::kHrc) settings.hrc.progress = ProgressBar("HRC");
     }
     const Solution solution = instanced
                                   ? RunInstanced(scene, flat, whole ? &prepared->Rays() : nullptr,

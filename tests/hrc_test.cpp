@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "solver/generate/generator.h"
 #include "solver/radiosity/form_factor.h"
@@ -349,6 +351,36 @@ TEST(HrcTree, SameAnswerWhateverTheThreadCount) {
     for (std::size_t r = 0; r < one.light.size(); ++r) {
         EXPECT_EQ(one.light[r][0].irradianceUpperWm2, two.light[r][0].irradianceUpperWm2) << r;
         EXPECT_EQ(one.light[r][0].irradianceLowerWm2, two.light[r][0].irradianceLowerWm2) << r;
+    }
+}
+
+// The progress bar's feed (HrcOptions::progress): it starts above 0, never goes back, ends
+// at exactly 1 and moves in between (the refinement's tasks carried out, the sweeps'
+// change falling); watching the solve does not change its answer.
+TEST(HrcTree, ProgressRisesToOneAndLeavesTheAnswerAsItWas) {
+    const Scene scene = SmallTree({0.45, 0.45, 0.45, 0.45});
+    const PreparedScene prepared(scene);
+    SolverSettings settings = HrcSettings(1e-5);
+    const Solution unwatched = Solve(prepared, settings);
+    std::vector<double> reports;
+    settings.hrc.progress = [&](double done) { reports.push_back(done); };
+    const Solution watched = Solve(prepared, settings);
+    ASSERT_GE(reports.size(), 10u);
+    EXPECT_GT(reports.front(), 0.0);
+    EXPECT_TRUE(std::is_sorted(reports.begin(), reports.end()));
+    EXPECT_EQ(std::adjacent_find(reports.begin(), reports.end()), reports.end()) << "repeats";
+    EXPECT_EQ(reports.back(), 1.0);
+    // Every stage reports (hrc.cpp's Stage constants: exposure, source links, the other links,
+    // the passes, the outputs), and the passes more than their end.
+    for (auto [from, to] :
+         {std::pair{0.0, 0.05}, {0.05, 0.2}, {0.2, 0.67}, {0.67, 0.96}, {0.97, 1.0}}) {
+        EXPECT_TRUE(std::any_of(reports.begin(), reports.end(),
+                                [&](double d) { return d > from && d <= to; }))
+            << "nothing reported in (" << from << ", " << to << "]";
+    }
+    for (std::size_t r = 0; r < watched.light.size(); ++r) {
+        EXPECT_EQ(watched.light[r][0].irradianceUpperWm2, unwatched.light[r][0].irradianceUpperWm2);
+        EXPECT_EQ(watched.light[r][0].irradianceLowerWm2, unwatched.light[r][0].irradianceLowerWm2);
     }
 }
 

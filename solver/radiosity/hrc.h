@@ -41,6 +41,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 
 #include "solver/radiosity/channels.h"
@@ -92,6 +93,11 @@ struct HrcOptions {
     // partition of the exchanges among the links checked (Solution::linkAudit).
     bool auditLinks = false;
     int threads = 0;  // 0: every core
+    // Called with the fraction of the solve done (0 to 1), when set: a progress bar. The
+    // solve's stages take fixed parts of it (hrc.cpp, the Stage constants); within a stage, the
+    // refinement counts the parts of its tasks carried out and the iteration how far its
+    // change has fallen towards `tolerance`.
+    std::function<void(double)> progress;
     // A continuous sky is discretised into these cones for the hierarchy's links.
     SkyDiscretization skyCones = SkyDiscretization::kTurtle46;
     // A closed instance sends what its phase function makes of its light towards each

@@ -31,6 +31,10 @@ void Refiner::SplitNode(std::uint32_t n) {
 // the same links whatever the number of threads.
 void Refiner::Refine(std::vector<Task> stack) {
     constexpr std::size_t kChunk = 4096;
+    if (std::all_of(stack.begin(), stack.end(), [](const Task& t) { return t.share <= 0.0f; })) {
+        for (Task& task : stack) task.share = 1.0f / static_cast<float>(stack.size());
+    }
+    done_ = 0.0;
     std::vector<Task> chunk;
     std::vector<Verdict> verdicts;
     while (!stack.empty()) {
@@ -42,6 +46,7 @@ void Refiner::Refine(std::vector<Task> stack) {
                           [&](std::size_t i) { verdicts[i] = Judge(chunk[i]); });
         // Carried out in reverse so that the first task's parts are on top of the stack.
         for (std::size_t i = take; i-- > 0;) Carry(chunk[i], verdicts[i], stack);
+        if (progress_) progress_(std::min(done_, 1.0));
     }
 }
 
@@ -66,20 +71,27 @@ void Refiner::Carry(const Task& task, const Verdict& verdict, std::vector<Task>&
     if (task.kind == Task::kSelf) {
         // A patch does not see itself; a closed instance's phase function holds its own
         // exchanges.
-        if (hierarchy_[r].patch || hierarchy_[r].closed >= 0 || model_.Held(r)) return;
         const auto& children = hierarchy_[r].children;
+        if (hierarchy_[r].patch || hierarchy_[r].closed >= 0 || model_.Held(r) ||
+            children.empty()) {
+            done_ += task.share;
+            return;
+        }
+        const float share = task.share / static_cast<float>(children.size() * children.size());
         for (auto i = children.rbegin(); i != children.rend(); ++i) {
-            stack.push_back({Task::kSelf, *i, *i});
+            stack.push_back({Task::kSelf, *i, *i, share});
             for (auto j = children.rbegin(); j != children.rend(); ++j) {
-                if (i != j) stack.push_back({Task::kPair, *i, *j});
+                if (i != j) stack.push_back({Task::kPair, *i, *j, share});
             }
         }
         return;
     }
     switch (verdict.kind) {
         case Verdict::kNone:
+            done_ += task.share;
             return;
         case Verdict::kLink:
+            done_ += task.share;
             if (task.kind == Task::kSource) {
                 links_.source[r].push_back({s, verdict.visibility});
             } else {
@@ -92,8 +104,9 @@ void Refiner::Carry(const Task& task, const Verdict& verdict, std::vector<Task>&
             SplitNode(receiver ? r : s);
             const auto& children = hierarchy_[receiver ? r : s].children;
             const Task::Kind kind = task.kind == Task::kSource ? Task::kSource : Task::kPair;
+            const float share = task.share / static_cast<float>(children.size());
             for (auto child = children.rbegin(); child != children.rend(); ++child) {
-                stack.push_back({kind, receiver ? *child : r, receiver ? s : *child});
+                stack.push_back({kind, receiver ? *child : r, receiver ? s : *child, share});
             }
             return;
         }

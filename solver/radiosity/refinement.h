@@ -32,6 +32,9 @@ struct Task {
     };
     Kind kind;
     std::uint32_t r, s;
+    // Its part of the refinement it belongs to (Refiner::Refine): a task's parts share
+    // its part, and the parts of tasks carried out add up to the fraction done.
+    float share = 0.0f;
 };
 
 // The error a link may carry (W).
@@ -67,8 +70,13 @@ class Refiner {
           thresholds_(thresholds),
           onSplit_(std::move(onSplit)) {}
 
-    // Works through the tasks (and the tasks their splits make).
+    // Called after each chunk of tasks with the fraction of the refinement done (0 to 1).
+    using ProgressHook = std::function<void(double done)>;
+
+    // Works through the tasks (and the tasks their splits make). Tasks given without a
+    // share take an equal part of the whole.
     void Refine(std::vector<Task> stack);
+    void OnProgress(ProgressHook progress) { progress_ = std::move(progress); }
     // Refinement judges a link by the light its sender sends when it is made: a sender lit
     // only by light scattered later (a wall facing away from a lamp, the ceiling of a
     // closed greenhouse) was dark then and linked coarsely. With the radiosities of a
@@ -134,6 +142,8 @@ class Refiner {
     const std::vector<DirectionalSource>& sources_;
     const Thresholds thresholds_;
     SplitHook onSplit_;
+    ProgressHook progress_;
+    double done_ = 0.0;  // the shares of the tasks carried out
     std::int64_t rays_ = 0;
     std::uint32_t localRoot_ = kNoNode;
 };
