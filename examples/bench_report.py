@@ -8,7 +8,8 @@ between its `<!-- report:NAME -->` and `<!-- /report:NAME -->` markers, so that 
 what the last run measured and nothing else: docs/results.md holds every table (one section
 per scene), README.md one summary of the error tables (`report:summary`).
 
-Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon]
+Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon,
+                       daemon-accuracy,soak,rays]
                       [--scenes a,b]
                       [--scaling-solvers hrc,mc]
        bench_report.py --tables-only [--only ...]   # rewrite from examples/report/, run nothing
@@ -253,11 +254,143 @@ def daemon_section(build, out, run=True):
             keys.append(key)
     for what, leaves, epsilon in sorted(keys, key=lambda k: (int(k[1]), float(k[2]), list(names).index(k[0]))):
         cycle = [r for r in rows if (r["what"], r["leaves"], r["epsilon"]) == (what, leaves, epsilon)]
-        times = sorted(float(r["solve_ms"]) for r in cycle)
-        median = 0.5 * (times[(len(times) - 1) // 2] + times[len(times) // 2])
-        table.append(f"| {names[what]} | {int(leaves):,} | {float(epsilon):.0e} | {number(median)} | "
+        solve = median(float(r["solve_ms"]) for r in cycle)
+        table.append(f"| {names[what]} | {int(leaves):,} | {float(epsilon):.0e} | {number(solve)} | "
                      f"{number(cycle[-1]['solve_ms'])} | {sum(int(r['phase_computed']) for r in cycle)} |")
     return "\n".join(table)
+
+
+def median(values):
+    ordered = sorted(values)
+    return 0.5 * (ordered[(len(ordered) - 1) // 2] + ordered[len(ordered) // 2])
+
+
+def spread(values, unit=""):
+    """`low–high (median)` of a few runs' values."""
+    low, high = min(values), max(values)
+    if number(low) == number(high):
+        return f"{number(low)}{unit}"
+    return f"{number(low)}–{number(high)} ({number(median(values))}){unit}"
+
+
+def daemon_protocol_section():
+    """The protocol's own cost, from leaflux_bench_daemon's CSV (run by daemon_section): a
+    Status round trip and a cycle of the grown plant with nothing changed."""
+    rows = list(csv.DictReader(open(os.path.join(REPORT, "daemon_bench.csv"))))
+    status = next(r for r in rows if r["what"] == "status")
+    table = [f"A Status round trip takes {number(status['round_trip_ms'])} ms (mean of many). A cycle with an "
+             "empty delta asking the last cycle's outputs sends its light again unsolved; asking no outputs, "
+             "as the last did, it is the protocol alone (both medians of 200); asking other outputs, it is "
+             "solved again:", "",
+             "| leaves | ε | organs in the reply | outputs sent again: round trip ms | the protocol alone ms | "
+             "solved again: round trip / solving ms |", "|---|---|---|---|---|---|"]
+    at = {(r["what"], r["leaves"], r["epsilon"]): r for r in rows}
+    for what, leaves, epsilon in at:
+        if what != "empty_delta":
+            continue
+        again, alone = at[(what, leaves, epsilon)], at[("empty_nothing", leaves, epsilon)]
+        solved = at[("empty_resolve", leaves, epsilon)]
+        table.append(f"| {int(leaves):,} | {float(epsilon):.0e} | {int(again['organs']):,} | "
+                     f"{number(again['round_trip_ms'])} | {number(alone['round_trip_ms'])} | "
+                     f"{number(solved['round_trip_ms'])} / {number(solved['solve_ms'])} |")
+    return "\n".join(table)
+
+
+def rays_section(build, out, run=True):
+    """Runs leaflux_bench_raytrace (Google Benchmark, three repetitions) and
+    leaflux_bench_reference: rays per second of the ray engine, and the Monte Carlo paths a
+    10,000-leaf tree needs for 1 % standard error."""
+    if run:
+        os.makedirs(out, exist_ok=True)
+        raytrace = os.path.join(out, "raytrace.csv")
+        subprocess.run([os.path.join(build, "tests", "leaflux_bench_raytrace"), "--benchmark_repetitions=3",
+                        f"--benchmark_out={raytrace}", "--benchmark_out_format=csv"], check=True)
+        shutil.copy(raytrace, os.path.join(REPORT, "raytrace.csv"))
+    bench_rows(build, out, "leaflux_bench_reference", "reference_bench.csv", run)
+    with open(os.path.join(REPORT, "raytrace.csv")) as f:  # the header follows Google Benchmark's context lines
+        lines = f.read().splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("name,"))
+    runs = list(csv.DictReader(lines[start:]))
+    what = {"occlusion_from_bounds": "occlusion, rays from random points of the bounds in random directions",
+            "closest_hit_from_bounds": "closest hit, the same rays",
+            "occlusion_from_surfaces": "occlusion, rays leaving random triangles (what the solvers shoot)",
+            "closest_hit_from_surfaces": "closest hit, the same rays"}
+    triangles = next(float(r["triangles"]) for r in runs if r["triangles"])
+    table = [f"Ray engine on a generated tree of 10⁵ leaves ({triangles:,.0f} triangles), both cores, "
+             "three runs:", "", "| rays | M rays/s: range (median) | hit fraction |", "|---|---|---|"]
+    for name, label in what.items():
+        # The repetitions ("NAME/min_time:2.000/real_time"), not their aggregates ("…_mean").
+        at = [r for r in runs if r["name"].split("/")[0] == name and r["name"].endswith("real_time")]
+        table.append(f"| {label} | {spread([float(r['rays_per_s']) / 1e6 for r in at])} | "
+                     f"{number(median(float(r['hit_fraction']) for r in at))} |")
+    reference = list(csv.DictReader(open(os.path.join(REPORT, "reference_bench.csv"))))
+    table += ["", "Monte Carlo on a 10,000-leaf tree, NIR (ρ = τ = 0.45), sun + CIE overcast sky: the paths "
+              "per leaf that reach a median relative standard error of 1 % over lit leaves (the first run "
+              "aims, the second checks):", "",
+              "| paths per leaf | wall s | cpu s | median relative standard error % | lit leaves | rays | peak MiB |",
+              "|---|---|---|---|---|---|---|"]
+    for r in reference:
+        table.append(f"| {int(r['samples_per_leaf']):,} | {number(r['wall_s'])} | {number(r['cpu_s'])} | "
+                     f"{100 * float(r['median_rel_stderr']):.2f} | {int(r['lit_leaves']):,} | "
+                     f"{int(r['rays']):,} | {number(r['peak_rss_mib'])} |")
+    return "\n".join(table)
+
+
+# The daemon's growing trees as scenes (no ground, 46-cone sky: ε relative to the plant's own
+# light) and the ε of its cycles: (name, leaves).
+DAEMON_TREES = [("tree1k_bare", 1000), ("tree10k_bare", 10000)]
+DAEMON_EPSILONS = ["1e-4", "3e-4", "1e-3"]
+DAEMON_GOAL_PCT = 2.0  # the L2 error a cycle is asked to stay within, per band
+
+
+def daemon_accuracy_section(build, out, run=True):
+    """`leaflux bench error` on the daemon's trees at the ε of its cycles (HRC only): how much
+    accuracy each ε costs, and the coarsest ε within DAEMON_GOAL_PCT in every band."""
+    leaflux = os.path.join(build, "server", "leaflux")
+    table = ["| tree | " + " | ".join(f"ε = {e}: L2 % of max, by band" for e in DAEMON_EPSILONS) + " |",
+             "|---|" + "---|" * len(DAEMON_EPSILONS)]
+    coarsest = []
+    for name, leaves in DAEMON_TREES:
+        if run:
+            os.makedirs(out, exist_ok=True)
+            scene = os.path.join(out, f"{name}.scene.txtpb")
+            subprocess.run([leaflux, "generate", "--leaves", str(leaves), "--no-ground", "--sky-cones", "turtle46",
+                            "--out", scene], check=True, capture_output=True)
+            subprocess.run([leaflux, "bench", "error", "--scene", scene, "--name", name, "--out", out,
+                            "--cache", os.path.join(out, "cache"), "--no-mc", "--no-direct", "--no-plot",
+                            "--hrc-epsilon", ",".join(DAEMON_EPSILONS)], check=True)
+            shutil.copy(os.path.join(out, f"{name}.csv"), os.path.join(REPORT, f"daemon_accuracy_{name}.csv"))
+        rows = list(csv.DictReader(open(os.path.join(REPORT, f"daemon_accuracy_{name}.csv"))))
+        cells, within = [], None
+        for epsilon in DAEMON_EPSILONS:
+            at = [r for r in rows if r["solver"] == "hrc" and r["setting"].startswith("epsilon=")
+                  and float(r["setting"].split("=")[1]) == float(epsilon)]
+            cells.append(" / ".join(f"{r['band']} {number(r['l2_pct_of_max'])}" for r in at))
+            if all(float(r["l2_pct_of_max"]) <= DAEMON_GOAL_PCT for r in at):
+                within = epsilon
+        table.append(f"| {leaves:,} leaves | " + " | ".join(cells) + " |")
+        coarsest.append(f"{within} for the {leaves:,}-leaf plant" if within
+                        else f"none of these for the {leaves:,}-leaf plant")
+    table += ["", f"The coarsest ε whose cycles stay within {DAEMON_GOAL_PCT:g} % L2 in every band: "
+              + "; ".join(coarsest) + " (their times are in the daemon's tables above)."]
+    return "\n".join(table)
+
+
+def soak_section(build, out, run=True):
+    """Runs tests/daemon_soak.py (also in the test suite): many clients cycling and churning
+    sessions on one daemon; its throughput, latency and resident memory."""
+    name = "daemon_soak.csv"
+    if run:
+        os.makedirs(out, exist_ok=True)
+        subprocess.run([sys.executable, os.path.join(ROOT, "tests", "daemon_soak.py"), "--leafluxd",
+                        os.path.join(build, "server", "leafluxd"), "--csv", os.path.join(out, name)], check=True)
+        shutil.copy(os.path.join(out, name), os.path.join(REPORT, name))
+    r = next(csv.DictReader(open(os.path.join(REPORT, name))))
+    mib = lambda column: f"{int(r[column]) / 1024:.1f} MiB"
+    return (f"{int(r['clients'])} clients, {int(r['cycles']):,} cycles in {number(r['seconds'])} s: "
+            f"{number(r['cycles_per_s'])} cycles/s, latency p50 {number(r['p50_ms'])} ms and p99 "
+            f"{number(r['p99_ms'])} ms; resident memory {mib('rss_before_kb')} after the warm-up and "
+            f"{mib('rss_after_kb')} at the end (the test fails above +{mib('rss_bound_kb')}).")
 
 
 def demo_section():
@@ -481,7 +614,7 @@ def main():
                         help="build directory (default: build/release)")
     parser.add_argument("out", nargs="?", default=os.path.join(ROOT, "out", "report"),
                         help="directory of the runs' files (default: out/report)")
-    parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon",
+    parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon,daemon-accuracy,soak,rays",
                         help="parts to run (default: all)")
     parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
     parser.add_argument("--scaling-solvers", default="hrc,mc",
@@ -517,6 +650,14 @@ def main():
         update(RESULTS, "growth-instanced", instancing_section())
     if "daemon" in parts:
         update(RESULTS, "daemon", daemon_section(build, os.path.join(out, "daemon"), run))
+        update(RESULTS, "daemon-protocol", daemon_protocol_section())
+    if "daemon-accuracy" in parts:
+        update(RESULTS, "daemon-accuracy",
+               daemon_accuracy_section(build, os.path.join(out, "daemon_accuracy"), run))
+    if "soak" in parts:
+        update(RESULTS, "soak", soak_section(build, os.path.join(out, "soak"), run))
+    if "rays" in parts:
+        update(RESULTS, "rays", rays_section(build, os.path.join(out, "rays"), run))
     if "phase-db" in parts:
         update(RESULTS, "phase-db", phase_db_section(build, os.path.join(out, "phase"), run))
     if "phase-spread" in parts:
