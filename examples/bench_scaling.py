@@ -37,14 +37,21 @@ def plantation(leaflux, out_dir, trees):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("build")
-    parser.add_argument("out")
-    parser.add_argument("--leaves", default="1000,10000,100000,1000000")
-    parser.add_argument("--trees", default="1,4,16,64,233")
-    parser.add_argument("--epsilon", default="1e-5")
-    parser.add_argument("--samples", default="256")
+    parser.add_argument("build", help="the build folder, with server/leaflux")
+    parser.add_argument("out", help="folder of the scenes, scaling.csv, fits.csv and scaling.png "
+                        "(made when missing)")
+    parser.add_argument("--leaves", default="1000,10000,100000,1000000",
+                        help="leaves of each generated tree, comma-separated; empty: none "
+                        "(default: %(default)s)")
+    parser.add_argument("--trees", default="1,4,16,64,233",
+                        help="trees of 1,000 leaves in each plantation, comma-separated; empty: "
+                        "none (default: %(default)s)")
+    parser.add_argument("--epsilon", default="1e-5", help="HRC's ε (default: %(default)s)")
+    parser.add_argument("--samples", default="256",
+                        help="Monte Carlo paths per receiver (default: %(default)s)")
     parser.add_argument("--solvers", default="hrc,mc",
-                        help="solvers to run; the rows of the others are kept from OUT/scaling.csv")
+                        help="solvers to run; the rows of the others are kept from OUT/scaling.csv "
+                        "(default: %(default)s)")
     args = parser.parse_args()
     run_solvers = args.solvers.split(",")
     kept = {}
