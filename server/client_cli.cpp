@@ -30,7 +30,16 @@ void WriteBand(std::ostream& out, const v1::BandLight& b) {
     } else {
         out << ",,";
     }
-    out << ',' << Repr(b.stderr_upper_wm2()) << ',' << Repr(b.stderr_lower_wm2()) << '\n';
+    out << ',' << Repr(b.stderr_upper_wm2()) << ',' << Repr(b.stderr_lower_wm2());
+    // Unset for a band without a photon unit: empty cells, as in `leaflux solve --out`.
+    const auto photons = [&](bool has, double value) {
+        out << ',';
+        if (has) out << Repr(value);
+    };
+    photons(b.has_photon_irradiance_upper_umol_m2_s(), b.photon_irradiance_upper_umol_m2_s());
+    photons(b.has_photon_irradiance_lower_umol_m2_s(), b.photon_irradiance_lower_umol_m2_s());
+    photons(b.has_absorbed_umol_s(), b.absorbed_umol_s());
+    out << '\n';
 }
 
 v1::Request OpenFromFile(const ClientCommand& command) {
@@ -108,7 +117,8 @@ int RunClient(const ClientCommand& command, const v1::Request& request) {
 void WriteCycleCsv(std::ostream& out, const v1::CycleResult& cycle) {
     out << "cycle,kind,node,name,type,organs,area_m2,band,irradiance_upper_wm2,"
            "irradiance_lower_wm2,absorbed_w,light_vector_x,light_vector_y,light_vector_z,"
-           "stderr_upper_wm2,stderr_lower_wm2\n";
+           "stderr_upper_wm2,stderr_lower_wm2,photon_irradiance_upper_umol_m2_s,"
+           "photon_irradiance_lower_umol_m2_s,absorbed_umol_s\n";
     for (const v1::OrganLight& organ : cycle.organs()) {
         for (const v1::BandLight& b : organ.bands()) {
             out << cycle.number() << ",organ," << organ.node() << ',' << CsvQuoted(organ.name())
@@ -205,8 +215,12 @@ ClientApps AddClientCommand(CLI::App& app, ClientCommand& command) {
     apps.cycle->add_flag("--structures", command.structures, "Per-structure results");
     apps.cycle->add_option(
         "--out", command.out,
-        "Write the cycle's light to this CSV file (the Python package's columns, which "
-        "leaflux.CycleLight.read_csv reads) and print a summary, not the reply");
+        "Write the cycle's light to this CSV file (its folder is made; the Python package's "
+        "columns, which leaflux.CycleLight.read_csv reads: cycle,kind,node,name,type,organs,"
+        "area_m2,band,irradiance_upper_wm2,irradiance_lower_wm2,absorbed_w,light_vector_x,"
+        "light_vector_y,light_vector_z,stderr_upper_wm2,stderr_lower_wm2, then PAR in photons: "
+        "photon_irradiance_upper_umol_m2_s,photon_irradiance_lower_umol_m2_s,absorbed_umol_s, "
+        "empty for a band without a photon unit) and print a summary, not the reply");
     apps.status = client.add_subcommand("status", "The daemon's or a session's status");
     apps.status->add_option("--session", command.session, "Session id (empty: the daemon's)");
     apps.close = client.add_subcommand("close", "Close a session");

@@ -4,8 +4,8 @@
 # 1e4; output paths checked (and their folders made) before a solve; generate refuses a
 # scene that cannot fit in memory at once, with its estimate, and options its kind of scene
 # ignores; leaflux-grow's --ply-cycles and stand options; solve's CSV in W and µmol; client
-# cycle --out writes the Python package's CSV and prints a summary; the example scripts
-# run as they are and answer --help.
+# cycle --out writes the Python package's CSV, in W and µmol (empty for a band without a
+# photon unit), and prints a summary; the example scripts run as they are and answer --help.
 # Usage: cli_checks.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
 leaflux=$1/server/leaflux
@@ -132,6 +132,26 @@ leaf = next(r for r in rows if r["kind"] == "organ" and r["name"] == "leaf")
 assert float(leaf["irradiance_upper_wm2"]) > 100, leaf
 plant = next(r for r in rows if r["kind"] == "structure" and r["type"] == "NODE_TYPE_PLANT")
 assert abs(float(plant["absorbed_w"]) - float(leaf["absorbed_w"])) < 1e-9, (plant, leaf)
+for r in rows:  # PAR in photons: 4.57 µmol/J times each W column
+    for photons, watts in (("photon_irradiance_upper_umol_m2_s", "irradiance_upper_wm2"),
+                           ("photon_irradiance_lower_umol_m2_s", "irradiance_lower_wm2"),
+                           ("absorbed_umol_s", "absorbed_w")):
+        assert abs(float(r[photons]) - 4.57 * float(r[watts])) <= 1e-9 * (1 + float(r[photons])), r
+PY
+# A band without a photon unit (NIR) has empty photon cells.
+"$leaflux" generate --leaves 5 --no-sky --out "$out/two_bands.scene.txtpb" > /dev/null
+"$leaflux" client --endpoint "$endpoint" open --scene "$out/two_bands.scene.txtpb" > "$out/open.txt"
+session=$(sed -n 's/.*session: "\([0-9a-f]*\)".*/\1/p' "$out/open.txt")
+"$leaflux" client --endpoint "$endpoint" cycle --session "$session" --number 1 \
+    --out "$out/cycle/two_bands.csv" > /dev/null
+/usr/bin/python3 - "$out/cycle/two_bands.csv" << 'PY' || fail "cycle CSV of PAR and NIR"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert {r["band"] for r in rows} == {"PAR", "NIR"}, rows
+for r in rows:
+    cells = [r["photon_irradiance_upper_umol_m2_s"], r["photon_irradiance_lower_umol_m2_s"],
+             r["absorbed_umol_s"]]
+    assert all(cells) if r["band"] == "PAR" else not any(cells), r
 PY
 echo "help defaults, whole numbers, memory estimate, ignored options, output paths, µmol" \
      "columns, leaflux-grow's checks and client cycle --out checked"

@@ -9,10 +9,11 @@ it is installed (Debian python3-pytest), with a plain runner otherwise.
 
 The tests: the package is the installed one, its protoc-generated modules import; a
 LocalDaemon lights a small scene over cycles (finite light, the sun's irradiance on an
-unshaded leaf, absorbed power within what reaches it, the energy balance); CSV round trip;
-a pandas DataFrame (skipped without pandas) and a clear error without it; a request to no
-daemon raises RequestTimeout naming the endpoint within its timeout; a stale reply (of
-another request id) is dropped; errors are typed with code and field; a cycle given
+unshaded leaf, absorbed power within what reaches it, the energy balance); PAR in photons
+from the daemon (4.57 times the W figures; None, and empty CSV cells, for NIR); CSV round
+trip; a pandas DataFrame (skipped without pandas) and a clear error without it; a request
+to no daemon raises RequestTimeout naming the endpoint within its timeout; a stale reply
+(of another request id) is dropped; errors are typed with code and field; a cycle given
 resync= survives the daemon's SIGKILL and restart.
 
 Usage: python_package_test.py [BUILD_DIR]   (or $LEAFLUX_BUILD; leafluxd in BUILD_DIR/server)
@@ -20,6 +21,7 @@ Usage: python_package_test.py [BUILD_DIR]   (or $LEAFLUX_BUILD; leafluxd in BUIL
 """
 from __future__ import annotations
 
+import csv
 import math
 import os
 import shutil
@@ -208,6 +210,50 @@ def test_photon_units():
     # The top leaf under the 400 W/m² sun: 1,828 µmol m⁻² s⁻¹.
     top = light().organ(10).band("PAR")
     assert abs(top.irradiance_upper_wm2 * photon_umol_per_j(pb.Band(name="PAR")) - 1828) < 20
+
+
+def test_photon_light_from_the_daemon():
+    from leaflux import Client, CycleLight, pb
+    s = scene(2)
+    s.bands.add(name="NIR", wavelength_min_nm=700, wavelength_max_nm=2500)  # no photon unit
+    for optics in s.optics:
+        optics.bands["NIR"].CopyFrom(optics.bands["PAR"])
+    s.suns[0].normal_irradiance["NIR"] = 300
+    with daemon() as d, Client(d.endpoint) as client:
+        session = client.open(s, hrc())
+        cycle = client.cycle(session, 1, structures=True)
+    items = [*cycle.organs, *cycle.structures]
+    assert items and all(len(i.bands) == 2 for i in items), items
+    for item in items:
+        par, nir = item.band("PAR"), item.band("NIR")
+        for photons, watts in ((par.photon_irradiance_upper_umol_m2_s, par.irradiance_upper_wm2),
+                               (par.photon_irradiance_lower_umol_m2_s, par.irradiance_lower_wm2),
+                               (par.absorbed_umol_s, par.absorbed_w)):
+            assert photons is not None and abs(photons - 4.57 * watts) <= 1e-9 * (1 + photons), \
+                (item, photons, watts)
+        assert (nir.photon_irradiance_upper_umol_m2_s, nir.photon_irradiance_lower_umol_m2_s,
+                nir.absorbed_umol_s) == (None, None, None), item
+    assert cycle.organ(10).band("PAR").photon_irradiance_upper_umol_m2_s > 1800  # 400 W/m²
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "cycle.csv")
+        cycle.to_csv(path)
+        with open(path) as f:
+            rows = list(csv.DictReader(f))
+        back = CycleLight.read_csv(path)
+    for row in rows:
+        filled = row["band"] == "PAR"
+        for column in ("photon_irradiance_upper_umol_m2_s", "photon_irradiance_lower_umol_m2_s",
+                       "absorbed_umol_s"):
+            assert bool(row[column]) == filled, row  # an empty cell for NIR
+    assert back.organs == cycle.organs and back.structures == cycle.structures
+    try:
+        import pandas  # noqa: F401
+    except ImportError:
+        return
+    frame = cycle.to_dataframe()
+    par = frame[frame.band == "PAR"]
+    assert ((par.absorbed_umol_s - 4.57 * par.absorbed_w).abs() < 1e-9 * (1 + par.absorbed_umol_s)).all()
+    assert frame[frame.band == "NIR"].absorbed_umol_s.isna().all()
 
 
 def test_dataframe():

@@ -1,7 +1,8 @@
 """A cycle's light as plain objects, CSV rows or a pandas DataFrame.
 
 The names are the protocol's (leaflux.v1.CycleResult), units in the names: irradiance in
-W/m² on each side of an organ, absorbed power in W, areas in m².
+W/m² on each side of an organ, absorbed power in W, areas in m²; for a band with a photon
+unit (PAR) the same in µmol m⁻² s⁻¹ and µmol s⁻¹.
 """
 from __future__ import annotations
 
@@ -25,7 +26,9 @@ class Vector(NamedTuple):
 @dataclass
 class BandLight:
     """The light of one band on an organ or structure. `light_vector` is None when the
-    cycle asked for none; `stderr_*` are -1 when the solver gives no estimate (HRC)."""
+    cycle asked for none; `stderr_*` are -1 when the solver gives no estimate (HRC). The
+    photon figures (µmol m⁻² s⁻¹, µmol s⁻¹: the W figures times the band's
+    photon_umol_per_j, 4.57 for PAR) are None for a band without a photon unit."""
     band: str
     irradiance_upper_wm2: float
     irradiance_lower_wm2: float
@@ -33,13 +36,21 @@ class BandLight:
     light_vector: Optional[Vector] = None
     stderr_upper_wm2: float = -1.0
     stderr_lower_wm2: float = -1.0
+    photon_irradiance_upper_umol_m2_s: Optional[float] = None
+    photon_irradiance_lower_umol_m2_s: Optional[float] = None
+    absorbed_umol_s: Optional[float] = None
 
     @classmethod
     def from_proto(cls, b: "pb.BandLight") -> "BandLight":
         vector = (Vector(b.light_vector.x, b.light_vector.y, b.light_vector.z)
                   if b.HasField("light_vector") else None)
+
+        def photons(name: str) -> Optional[float]:  # unset: the band has no photon unit
+            return getattr(b, name) if b.HasField(name) else None
         return cls(b.band, b.irradiance_upper_wm2, b.irradiance_lower_wm2, b.absorbed_w,
-                   vector, b.stderr_upper_wm2, b.stderr_lower_wm2)
+                   vector, b.stderr_upper_wm2, b.stderr_lower_wm2,
+                   photons("photon_irradiance_upper_umol_m2_s"),
+                   photons("photon_irradiance_lower_umol_m2_s"), photons("absorbed_umol_s"))
 
 
 def _band(bands: List[BandLight], band: str, owner: str) -> BandLight:
@@ -122,9 +133,12 @@ class SolveStatistics:
 CSV_COLUMNS = ["cycle", "kind", "node", "name", "type", "organs", "area_m2", "band",
                "irradiance_upper_wm2", "irradiance_lower_wm2", "absorbed_w",
                "light_vector_x", "light_vector_y", "light_vector_z",
-               "stderr_upper_wm2", "stderr_lower_wm2"]
+               "stderr_upper_wm2", "stderr_lower_wm2", "photon_irradiance_upper_umol_m2_s",
+               "photon_irradiance_lower_umol_m2_s", "absorbed_umol_s"]
 """The columns of CycleLight.to_csv and to_dataframe: a row per organ (kind "organ") or
-structure (kind "structure") and band. Empty light_vector_* when none was asked for."""
+structure (kind "structure") and band. Empty light_vector_* when none was asked for, empty
+photon columns for a band without a photon unit; the photon columns are last, in the order
+of `leaflux solve --out`."""
 
 
 @dataclass
@@ -178,6 +192,9 @@ class CycleLight:
                     "light_vector_z": v.z if v else None,
                     "stderr_upper_wm2": b.stderr_upper_wm2,
                     "stderr_lower_wm2": b.stderr_lower_wm2,
+                    "photon_irradiance_upper_umol_m2_s": b.photon_irradiance_upper_umol_m2_s,
+                    "photon_irradiance_lower_umol_m2_s": b.photon_irradiance_lower_umol_m2_s,
+                    "absorbed_umol_s": b.absorbed_umol_s,
                 })
         return rows
 
@@ -196,6 +213,10 @@ class CycleLight:
         organs: Dict[Any, OrganLight] = {}
         structures: Dict[int, StructureLight] = {}
         number = 0
+
+        def optional(row: Dict[str, str], column: str) -> Optional[float]:
+            # Empty, or missing in a file written before the column was: None.
+            return float(row[column]) if row.get(column) else None
         with open(path, newline="") as f:
             for row in csv.DictReader(f):
                 number = int(row["cycle"])
@@ -206,7 +227,10 @@ class CycleLight:
                 light = BandLight(row["band"], float(row["irradiance_upper_wm2"]),
                                   float(row["irradiance_lower_wm2"]), float(row["absorbed_w"]),
                                   vector, float(row["stderr_upper_wm2"]),
-                                  float(row["stderr_lower_wm2"]))
+                                  float(row["stderr_lower_wm2"]),
+                                  optional(row, "photon_irradiance_upper_umol_m2_s"),
+                                  optional(row, "photon_irradiance_lower_umol_m2_s"),
+                                  optional(row, "absorbed_umol_s"))
                 if row["kind"] == "structure":
                     s = structures.setdefault(node, StructureLight(
                         node, row["name"], row["type"], int(row["organs"]),
