@@ -11,6 +11,7 @@
 #include <iostream>
 #include <optional>
 
+#include "server/cli_checks.h"
 #include "server/progress.h"
 #include "server/scene_proto.h"
 #include "solver/results/accuracy.h"
@@ -320,6 +321,9 @@ std::string DefaultCacheDirectory() {
 }
 
 int RunErrorBench(const ErrorBenchOptions& options) {
+    // Before the reference, which may take hours, as solve --out is checked before its solve.
+    CheckWritable(options.csv, "--out");
+    if (!options.png.empty()) CheckWritable(options.png, "--out");
     const Scene scene = LoadSceneFile(options.scene);
     const std::string& name = options.name;
     PreparedScene prepared(scene);
@@ -354,6 +358,7 @@ int RunErrorBench(const ErrorBenchOptions& options) {
         spdlog::info("{}: {} leaves; reference from {} (solved in {:.1f} s)", name, leaves,
                      cached.string(), reference->stats.wallSeconds);
     } else {
+        CheckWritable(cached.string() + ".partial", "--cache");  // before the solve, too
         spdlog::info("{}: {} leaves; solving the reference at {} paths per receiver", name, leaves,
                      options.referenceSamples);
         SolverSettings solving = referenceSettings;  // the same key, with a progress bar

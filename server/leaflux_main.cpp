@@ -255,7 +255,9 @@ int main(int argc, char** argv) {
         ->required()
         ->check(CLI::ExistingFile);
     errorApp->add_option("--name", errorBench.name, "The scene's name (default: the file's)");
-    errorApp->add_option("--out", errorBenchOut, "Directory of the CSV and the plot");
+    errorApp->add_option("--out", errorBenchOut,
+                         "Directory of the CSV and the plot (made; checked before the "
+                         "reference is solved)");
     errorApp->add_option("--cache", errorBench.cacheDirectory,
                          "Directory of cached references (default: " + DefaultCacheDirectory() +
                              "); delete a file there to solve it again");

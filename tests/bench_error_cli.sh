@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `leaflux bench error` as users run it: a small canopy, the reference solved once and
 # then read from the cache, a damaged cache file solved again, the CSV and plot written,
-# a missing scene refused with its name.
+# a missing scene refused with its name, an --out or --cache that cannot be written refused
+# before the reference is solved.
 # Usage: bench_error_cli.sh BUILD_DIR
 set -euo pipefail
 leaflux=$1/server/leaflux
@@ -37,4 +38,22 @@ grep -q "solving the reference" "$out/third.log" || fail "a damaged cache file s
 status=0
 "$leaflux" bench error --scene "$out/missing.txtpb" --out "$out/error" > "$out/missing.log" 2>&1 || status=$?
 test $status -ne 0 && grep -q "missing.txtpb" "$out/missing.log" || fail "a missing scene should be named"
-echo "leaflux bench error: reference cached and reused, damaged cache solved again, CSV written"
+# Output paths are checked before the reference is solved, and named.
+touch "$out/a_file"
+status=0
+"$leaflux" bench error --scene "$out/canopy.scene.txtpb" --out "$out/a_file/error" \
+    --cache "$out/cache" > "$out/unwritable.log" 2>&1 || status=$?
+test $status -ne 0 || fail "an --out below a file was accepted"
+grep -q -- "--out $out/a_file/error/canopy.csv: cannot be written" "$out/unwritable.log" ||
+    fail "an unwritable --out is not named: $(cat "$out/unwritable.log")"
+grep -q "leaves;" "$out/unwritable.log" && fail "the scene was solved before --out was checked"
+status=0
+"$leaflux" bench error --scene "$out/canopy.scene.txtpb" --out "$out/error" \
+    --cache "$out/a_file" > "$out/unwritable.log" 2>&1 || status=$?
+test $status -ne 0 || fail "a --cache below a file was accepted"
+grep -q -- "--cache $out/a_file/reference-.*: cannot be written" "$out/unwritable.log" ||
+    fail "an unwritable --cache is not named: $(cat "$out/unwritable.log")"
+grep -q "solving the reference" "$out/unwritable.log" &&
+    fail "the reference was solved before --cache was checked"
+echo "leaflux bench error: reference cached and reused, damaged cache solved again, CSV written," \
+     "unwritable --out and --cache refused first"
