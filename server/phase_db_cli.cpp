@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "server/cli_checks.h"
 #include "solver/instancing/original_codec.h"
 #include "solver/instancing/phase_db.h"
 #include "solver/instancing/phase_store.h"
@@ -175,7 +176,8 @@ PhaseDbCli::PhaseDbCli(CLI::App& parent) {
     select->add_option("--key", key_, "Its full key (as `list --keys` prints it)");
     select->add_option("--id", id_, "Its row id (as `list` prints it)");
     select->require_option(1);
-    export_->add_option("--out", out_, "CSV file ('-': standard output)")->capture_default_str();
+    export_->add_option("--out", out_, "CSV file (its folder is made; '-': standard output)")
+        ->capture_default_str();
 }
 
 bool PhaseDbCli::Parsed() const { return app_->parsed(); }
@@ -185,6 +187,8 @@ int PhaseDbCli::Run() const {
         PhaseStore store(path_, PhaseStoreMode::kExisting);
         return RunCompact(store);
     }
+    // As every --out: its folder made and the file checked before the database is read.
+    if (export_->parsed() && out_ != "-") CheckWritable(out_, "--out");
     PhaseStore store(path_, PhaseStoreMode::kReadOnly);
     if (stats_->parsed()) return RunStats(store);
     if (list_->parsed()) return RunList(store, keysOnly_);

@@ -28,6 +28,8 @@ chmod 644 "$out/server.secret"
 test "$(stat -c %a "$out/server.secret")" = 600 ||
     fail "server.secret is $(stat -c %a "$out/server.secret"), not 600"
 test "$(stat -c %a "$out/server.public")" = 644 || fail "server.public is not 644"
+"$leaflux" keygen --out "$out/keys/server" > /dev/null  # as the README has it: out/keys/server
+test -s "$out/keys/server.secret" -a -s "$out/keys/server.public" || fail "keygen made no folder"
 
 # An endpoint without its transport is refused for what it lacks.
 port=$((20000 + RANDOM % 20000))

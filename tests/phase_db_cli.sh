@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# `leaflux phase-db` as users run it: stats, list, export of a function to CSV, verify of a
-# sound and of a damaged file, compact, and refusal of a file that is not a phase database.
+# `leaflux phase-db` as users run it: stats, list, export of a function to CSV (into a new
+# folder too), verify of a sound and of a damaged file, compact, and refusal of a file that
+# is not a phase database.
 # Usage: phase_db_cli.sh BUILD_DIR
 set -euo pipefail
 build=$1
@@ -26,6 +27,9 @@ rows=$(wc -l < "$out/keys")
 [ "$(grep -c '^f,' "$out/f.csv")" -eq $((130 * 130 * 2)) ] || fail "f rows"
 "$leaflux" phase-db export --db "$db" --key "$(head -1 "$out/keys")" | cmp -s - "$out/f.csv" ||
     fail "export by key differs from export by id"
+# Its folder is made, as every --out's.
+"$leaflux" phase-db export --db "$db" --id 1 --out "$out/new/folder/f.csv" 2> /dev/null
+cmp -s "$out/new/folder/f.csv" "$out/f.csv" || fail "export into a new folder"
 
 # A damaged row: verify names it and fails, export refuses it.
 /usr/bin/python3 - "$db" << 'PY'
