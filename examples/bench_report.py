@@ -9,7 +9,7 @@ what the last run measured and nothing else: docs/results.md holds every table (
 per scene), README.md one summary of the error tables (`report:summary`).
 
 Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon,
-                       daemon-accuracy,soak,rays]
+                       daemon-accuracy,soak,rays,summary]
                       [--scenes a,b]
                       [--scaling-solvers hrc,mc]
        bench_report.py --tables-only [--only ...]   # rewrite from examples/report/, run nothing
@@ -129,24 +129,26 @@ def error_rows(name):
     return list(csv.DictReader(open(os.path.join(REPORT, f"error_{name}.csv"))))
 
 
-# The README's summary: these settings of each scene's error table.
+# The README's summary: these settings of each scene's error table (the instanced solver's
+# from the database its first run filled).
 SUMMARY = [("mc", "samples", 1024, "Monte Carlo, 1,024 paths"), ("hrc", "epsilon", 1e-4, "HRC, ε = 1e-4"),
-           ("hrc", "epsilon", 1e-5, "HRC, ε = 1e-5")]
+           ("hrc", "epsilon", 1e-5, "HRC, ε = 1e-5"), ("instanced", "epsilon", 1e-4, "instanced, ε = 1e-4")]
 
 
 def summary_section(names):
-    """One row per scene of docs/results.md's error tables: L2 error and wall time of a few
-    settings, for the README."""
-    table = ["| scene | leaves | " + " | ".join(f"{label}: L2 % PAR / NIR, wall s" for *_, label in SUMMARY) + " |",
-             "|---|---|" + "---|" * len(SUMMARY)]
+    """One row per scene of docs/results.md's error tables: L2 error, wall time and peak
+    memory of a few settings, for the README."""
+    table = ["| scene | leaves | " + " | ".join(f"{label}: L2 % PAR / NIR, wall s, MiB" for *_, label in SUMMARY)
+             + " |", "|---|---|" + "---|" * len(SUMMARY)]
     for name in names:
         rows = error_rows(name)
         cells = []
         for solver, key, value, _ in SUMMARY:
-            hit = [r for r in rows if r["solver"] == solver and r["setting"].startswith(key + "=")
-                   and float(r["setting"].split("=")[1]) == value]
-            cells.append(" / ".join(number(r["l2_pct_of_max"]) for r in hit) + f", {number(hit[0]['wall_s'])} s"
-                         if hit else "–")
+            # The setting alone ("epsilon=0.0001"), not its variants ("epsilon=0.0001 single-value").
+            hit = [r for r in rows if r["solver"] == solver and " " not in r["setting"]
+                   and r["setting"].startswith(key + "=") and float(r["setting"].split("=")[1]) == value]
+            cells.append(" / ".join(number(r["l2_pct_of_max"]) for r in hit)
+                         + f", {number(hit[0]['wall_s'])} s, {number(hit[0]['peak_mib'])}" if hit else "–")
         table.append(f"| [{name}](docs/results.md#{name}) | {int(rows[0]['leaves']):,} | " + " | ".join(cells) + " |")
     return "\n".join(table)
 
@@ -630,6 +632,8 @@ def main():
     run = not args.tables_only
     os.makedirs(REPORT, exist_ok=True)
     parts = args.only.split(",")
+    if "summary" in parts and "error" not in parts:
+        update(README, "summary", summary_section(list(SCENES)))
     if "error" in parts:
         os.makedirs(os.path.join(out, "error"), exist_ok=True)
         for name in args.scenes.split(","):
@@ -668,7 +672,7 @@ def main():
     if "stability" in parts:
         update(RESULTS, "stability", stability_section(build, os.path.join(out, "stability"), run))
     print(f"sections {args.only} rewritten in docs/results.md"
-          f"{' and the summary in README.md' if 'error' in parts else ''}; files in {REPORT}")
+          f"{' and the summary in README.md' if 'error' in parts or 'summary' in parts else ''}; files in {REPORT}")
 
 
 if __name__ == "__main__":
