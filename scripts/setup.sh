@@ -10,7 +10,7 @@ packages=(
     libprotobuf-dev protobuf-compiler
     libspdlog-dev libfmt-dev
     libgtest-dev libgmock-dev libbenchmark-dev
-    libsqlite3-dev libcli11-dev libpugixml-dev
+    libsqlite3-dev libcli11-dev libpugixml-dev libpng-dev
     python3 python3-zmq python3-protobuf python3-matplotlib python3-numpy
     python3-venv python3-pip python3-setuptools python3-pytest python3-pandas
     default-jdk-headless libjeromq-java libprotobuf-java

@@ -1,0 +1,182 @@
+#include "server/solve_cli.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+
+#include "server/cli_checks.h"
+#include "server/progress.h"
+#include "server/scene_proto.h"
+#include "solver/results/export.h"
+#include "solver/util/error.h"
+
+namespace leaflux {
+
+void AddHrcSettings(CLI::App& app, HrcOptions& hrc, const std::string& prefix,
+                    const std::string& label) {
+    app.add_option(prefix + "subdivision", hrc.maxSubdivision,
+                   label + "times a triangle may be split in four")
+        ->check(CLI::Range(0, 8));
+    app.add_option(prefix + "visibility-rays", hrc.visibilityRays,
+                   label + "rays estimating each link's visibility")
+        ->check(CLI::Range(1, 1024));
+    app.add_option(prefix + "source-rays", hrc.sourceRays,
+                   label + "rays estimating the visibility of each link from a sun or sky cone")
+        ->check(CLI::Range(1, 1024));
+    app.add_option(
+           prefix + "cluster-tolerance", hrc.clusterTolerance,
+           label +
+               "error a link from a surface into a cluster of organs may carry, as a fraction of ε")
+        ->check(CLI::Range(1e-3, 1.0));
+    app.add_option(prefix + "direction-level", hrc.directionLevel,
+                   label + "direction set of cluster light, 0..4 (4, 10, 34, 130, 514 directions)")
+        ->check(CLI::Range(0, 4));
+    app.add_option(prefix + "exposure-rays", hrc.exposureRays,
+                   label +
+                       "rays per child of a cluster and direction finding how open it is towards "
+                       "the light the cluster hands down (0: evenly by area)")
+        ->check(CLI::Range(0, 1024));
+}
+
+void AddSolverOptions(CLI::App& app, SolveCommand& command) {
+    app.add_option("--scene", command.scene, "Scene file (protobuf text format, leaflux.v1.Scene)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    app.add_option("--solver", command.solver,
+                   "Solver: mc (Monte Carlo reference), hrc (hierarchical radiosity with "
+                   "clustering) or instanced (hierarchical instantiation: structures the policy "
+                   "names solved as instances of shared phase functions, one at a time)")
+        ->check(CLI::IsMember({"mc", "hrc", "instanced"}));
+    app.add_option("--epsilon", command.epsilon,
+                   "hrc, instanced: largest error of a link, as a fraction of the power the suns "
+                   "and sky bring onto the organs (plus the lamps' power); surfaces far from the "
+                   "organs are allowed more by the square of their distance")
+        ->check(CLI::Range(1e-9, 1.0));
+    AddHrcSettings(app, command.hrc, "--", "hrc, instanced: ");
+    AddInstancedOptions(app, command.instanced);
+    app.add_option("--samples", command.samples, "mc: paths per receiver (standard error ~ 1/sqrt)")
+        ->transform(WholeNumber())
+        ->check(CLI::Range(2, 1 << 26));
+    app.add_option("--replicates", command.replicates,
+                   "mc: independent groups for the standard error")
+        ->transform(WholeNumber())
+        ->check(CLI::Range(2, 1024));
+    app.add_option("--seed", command.seed, "mc: random seed (same seed, same result)")
+        ->transform(WholeNumber());
+    app.add_flag("--direct-only", command.directOnly,
+                 "Light straight from the suns, the sky and the lamps only (no scattering)");
+    app.add_option("--threads", command.threads, "Worker threads (0: every core)")
+        ->transform(WholeNumber())
+        ->check(CLI::Range(0, 1024));
+    app.add_flag("--quiet", command.quiet, "No progress or log lines, only the summary");
+    app.add_flag("--strict", command.strict, kStrictHelp);
+}
+
+CLI::App* AddSolveCommand(CLI::App& app, SolveCommand& command) {
+    CLI::App* solve = app.add_subcommand("solve", "Light a scene file and write per-organ results");
+    AddSolverOptions(*solve, command);
+    solve->add_flag("--audit-links", command.hrc.auditLinks,
+                    "hrc: after the solve, set each kind of link against 64 rays from each "
+                    "side of every leaf patch (the power handed on, with the solution's "
+                    "radiosity), and check that the links cover every exchange once");
+    solve
+        ->add_option("--out", command.out,
+                     "Per-organ CSV (its folder is made): organ,band,area_m2,"
+                     "irradiance_upper_wm2,irradiance_lower_wm2,absorbed_w,light_x,light_y,"
+                     "light_z,stderr_upper_wm2,stderr_lower_wm2, then PAR in photons: "
+                     "photon_irradiance_upper_umol_m2_s,photon_irradiance_lower_umol_m2_s,"
+                     "absorbed_umol_s (the W columns times the band's photon_umol_per_j, "
+                     "4.57 for PAR; empty for a band without one)")
+        ->required();
+    solve->add_option("--structures", command.structures,
+                      "Per-structure CSV (plants, axes, phytomers)");
+    solve->add_option("--ply", command.ply,
+                      "PLY of the triangles with the first band's irradiance");
+    return solve;
+}
+
+std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
+                                        const std::function<void(const Scene&)>& check) {
+    const auto start = std::chrono::steady_clock::now();
+    auto solved = std::make_unique<SolvedScene>();
+    solved->scene = LoadSceneFile(command.scene, ImportOptions{command.strict});
+    const Scene& scene = solved->scene;
+    if (check) check(scene);
+    // The instanced solver with shadows by transmittance never flattens the scene whole.
+    const bool instanced = command.solver == "instanced";
+    const bool whole = !instanced || ShadowsByGeometry(command.instanced);
+    if (whole) {
+        solved->prepared.emplace(scene);
+    } else {
+        solved->receivers = ReceiversOf(scene);
+    }
+    const FlatScene& flat = solved->Flat();
+    SolverSettings settings;
+    settings.monteCarlo.samplesPerReceiver = command.samples;
+    settings.monteCarlo.replicates = command.replicates;
+    settings.monteCarlo.seed = command.seed;
+    settings.monteCarlo.threads = command.threads;
+    settings.kind = command.solver == "hrc" ? SolverKind::kHrc : SolverKind::kMonteCarlo;
+    settings.hrc = command.hrc;
+    settings.hrc.epsilon = command.epsilon;
+    settings.hrc.threads = command.threads;
+    settings.monteCarlo.directOnly = settings.hrc.directOnly = command.directOnly;
+    if (!command.quiet) {
+        spdlog::info(
+            "{}: {} receivers, {} triangles, {} bands; loaded in {:.2f} s", command.scene,
+            flat.receivers.size(), flat.triangles.size(), scene.bands.size(),
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        settings.monteCarlo.progress = ProgressBar("Monte Carlo");
+        if (settings.kind == SolverKind::kHrc) settings.hrc.progress = ProgressBar("HRC");
+    }
+    solved->solution = instanced
+                           ? RunInstanced(scene, flat, whole ? &solved->prepared->Rays() : nullptr,
+                                          settings.hrc, command.instanced)
+                           : Solve(*solved->prepared, settings);
+    return solved;
+}
+
+int RunSolve(const SolveCommand& command) {
+    // Before any work: a solve that cannot write its results fails now, not after it.
+    CheckWritable(command.out, "--out");
+    if (!command.structures.empty()) CheckWritable(command.structures, "--structures");
+    if (!command.ply.empty()) CheckWritable(command.ply, "--ply");
+    if (!command.instanced.problems.empty())
+        CheckWritable(command.instanced.problems, "--problems");
+    const std::unique_ptr<SolvedScene> solved = SolveScene(command);
+    const Scene& scene = solved->scene;
+    const FlatScene& flat = solved->Flat();
+    const Solution& solution = solved->solution;
+    std::ofstream leaves(command.out);
+    if (!leaves) throw InputError(ErrorCode::kIo, command.out, "cannot write");
+    WriteLeafCsv(leaves, scene, flat, solution);
+    if (!command.structures.empty()) {
+        std::ofstream structures(command.structures);
+        if (!structures) throw InputError(ErrorCode::kIo, command.structures, "cannot write");
+        WriteStructureCsv(structures, scene, AggregateStructures(scene, flat, solution));
+    }
+    if (!command.ply.empty()) {
+        std::ofstream ply(command.ply);
+        if (!ply) throw InputError(ErrorCode::kIo, command.ply, "cannot write");
+        WritePly(ply, flat, solution, 0);
+    }
+    std::cout << Summary(command.solver, scene, flat, solution) << std::endl;
+    for (const LinkAudit& audit : solution.linkAudit) {
+        if (audit.links == 0) {  // the partition's check: rays where no link or two cover
+            std::printf("points %-41s: rays find %.6g ± %.2g W\n", audit.kind.c_str(), audit.foundW,
+                        audit.foundStderrW);
+        } else if (audit.foundW > 0.0) {
+            std::printf(
+                "links %-42s %9lld: hand on %.6g W, rays from their receivers find %.6g ± %.2g W"
+                " (ratio %.4f)\n",
+                audit.kind.c_str(), static_cast<long long>(audit.links), audit.handedW,
+                audit.foundW, audit.foundStderrW, audit.handedW / audit.foundW);
+        }
+    }
+    return 0;
+}
+
+}  // namespace leaflux

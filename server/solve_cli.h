@@ -1,0 +1,57 @@
+// `leaflux solve`: the solver's options on the command line, a scene file loaded and solved,
+// and the per-organ results written. `leaflux render` takes the same options.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "server/instanced_cli.h"
+#include "solver/radiosity/hrc.h"
+#include "solver/solve.h"
+
+namespace leaflux {
+
+inline constexpr const char* kStrictHelp =
+    "Refuse imported files holding geometry that carries no light (zero-area faces, "
+    "zero-length organs, NaN diameters) instead of skipping it with a warning";
+
+struct SolveCommand {
+    std::string scene, solver = "hrc", out, structures, ply;
+    int samples = 1024, replicates = 16, threads = 0;
+    double epsilon = 1e-4;
+    HrcOptions hrc;  // subdivision, rays and directions; ε and threads are set apart
+    std::uint64_t seed = 1;
+    bool directOnly = false, quiet = false, strict = false;
+    InstancedCommand instanced;
+};
+
+// HRC's settings besides ε, as options named `prefix` + name, their help after `label`.
+void AddHrcSettings(CLI::App& app, HrcOptions& hrc, const std::string& prefix,
+                    const std::string& label);
+// The scene, the solver and its settings, as `solve` and `render` take them.
+void AddSolverOptions(CLI::App& app, SolveCommand& command);
+CLI::App* AddSolveCommand(CLI::App& app, SolveCommand& command);
+
+// A scene file loaded and solved. `prepared` holds the whole scene's rays unless the
+// instanced solver cast its shadows by transmittance (then `receivers` are the results'
+// receivers).
+struct SolvedScene {
+    Scene scene;
+    std::optional<PreparedScene> prepared;
+    FlatScene receivers;
+    Solution solution;
+
+    const FlatScene& Flat() const { return prepared ? prepared->Flat() : receivers; }
+};
+// `check`, when given, sees the scene once loaded, before the solve (what a picture's
+// settings need of it).
+std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
+                                        const std::function<void(const Scene&)>& check = {});
+
+int RunSolve(const SolveCommand& command);
+
+}  // namespace leaflux

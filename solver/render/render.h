@@ -1,0 +1,68 @@
+// Pictures of a solution (paper Fig. 13, 16, 20): primary rays through the ray engine,
+// several a pixel (anti-aliased), on every core; each surface they hit drawn in the false
+// colour of the quantity asked, and a colour bar below the view naming it.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "solver/raytrace/raytrace.h"
+#include "solver/render/camera.h"
+#include "solver/render/colour_scale.h"
+#include "solver/render/image.h"
+#include "solver/results/light.h"
+#include "solver/scene/scene.h"
+
+namespace leaflux {
+
+enum class Quantity {
+    kIrradiance,  // arriving on the side(s) asked, W/m²
+    kAbsorbed,    // absorbed power per area of the organ, both sides, W/m²
+    kRadiosity,   // leaving the side(s) asked: ρ E on that side + τ E from the other, W/m²
+};
+
+enum class Side {
+    kSeenSide,  // the side facing the camera
+    kUpperSide,
+    kLowerSide,
+    kBothSides,  // the two summed (the error tables' value of a leaf)
+};
+
+struct RenderSettings {
+    Camera camera;
+    int width = 1024, height = 768;  // the view; the colour bar comes below it
+    int samples = 4;                 // rays a pixel, on a stratified grid (rounded to a square)
+    Quantity quantity = Quantity::kIrradiance;
+    Side side = Side::kSeenSide;
+    int band = 0;
+    bool photons = false;  // in µmol m⁻² s⁻¹ (the band's photon factor) rather than W/m²
+    // The scale: from 0 to the largest value in view, unless given (a series of pictures
+    // sharing one scale); values beyond a given range are hatched.
+    std::optional<std::pair<double, double>> range;
+    Palette palette = Palette::kViridis;
+    int threads = 0;  // 0: every core
+};
+
+struct Rendering {
+    Image image;        // the view, with the colour bar below it
+    ColourScale scale;  // the one the view was drawn on
+    std::string caption;
+    int barLeft = 0, barRight = 0, barTop = 0, barBottom = 0;  // the bar's pixels, inclusive
+    std::int64_t rays = 0;
+    double beyondFraction = 0.0;  // of the samples on surfaces, those beyond the scale
+    double seconds = 0.0;
+
+    // The bar's column showing `value`.
+    int BarColumn(double value) const;
+};
+
+// Checks the settings against the scene (band, photon factor, size, range); the error
+// names the setting.
+void Validate(const RenderSettings& settings, const Scene& scene);
+
+// `solution` is the one solved on rays.Flat() (its receivers), as every solver returns.
+Rendering Render(const Scene& scene, const RayScene& rays, const Solution& solution,
+                 const RenderSettings& settings);
+
+}  // namespace leaflux

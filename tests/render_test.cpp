@@ -1,0 +1,189 @@
+// leaflux render: pictures that show what was solved. A plate under a known irradiance
+// takes the colour bar's colour at that value; a plate with half the irradiance is half as
+// bright on the linear grey scale; a bad camera is refused naming its field; a solution
+// read back from its CSV draws the same picture.
+#include "solver/render/render.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "solver/render/legend.h"
+#include "solver/results/export.h"
+#include "solver/results/read_leaf_csv.h"
+#include "solver/solve.h"
+#include "solver/util/error.h"
+#include "tests/scene_builders.h"
+
+namespace leaflux {
+namespace {
+
+using namespace leaflux::testing;
+
+// Black unit plates (no scattering: the irradiance is the sun's, in closed form) under a
+// vertical sun of `sun` W/m²; plate k at x = 3k, tilted by tiltDeg[k] about the y axis.
+Scene Plates(const std::vector<double>& tiltDeg, double sun) {
+    Scene scene = OneBandScene({{"black", Opaque(0.0)}});
+    for (std::size_t k = 0; k < tiltDeg.size(); ++k) {
+        const double t = glm::radians(tiltDeg[k]), x = 3.0 * k;
+        const glm::dvec3 u(0.5 * std::cos(t), 0.0, -0.5 * std::sin(t)), v(0.0, 0.5, 0.0);
+        const glm::dvec3 c(x, 0.0, 1.0);
+        scene.nodes.push_back(OrganNode(k + 1, "plate" + std::to_string(k),
+                                        Quad(c - u - v, c + u - v, c + u + v, c - u + v), "black"));
+    }
+    scene.sources.suns.push_back(SunAt(90.0, 0.0, sun));
+    scene.Validate();
+    return scene;
+}
+
+Solution SolveHrc(const PreparedScene& prepared) {
+    SolverSettings settings;
+    settings.kind = SolverKind::kHrc;
+    settings.hrc.epsilon = 1e-4;
+    return Solve(prepared, settings);
+}
+
+// A camera 10 m above the point (x, 0, 1), looking down, north at the top.
+Camera Above(double x) { return {{x, 0.0, 11.0}, {x, 0.0, 1.0}, {0.0, 1.0, 0.0}, 4.0}; }
+
+TEST(Render, APlateTakesTheColourBarsColourAtItsIrradiance) {
+    const double sun = 400.0;
+    const Scene scene = Plates({0.0}, sun);
+    const PreparedScene prepared(scene);
+    const Solution solution = SolveHrc(prepared);
+    ASSERT_NEAR(solution.light[0][0].irradianceUpperWm2, sun, 1e-6 * sun);
+    for (Palette palette : {Palette::kViridis, Palette::kGrey}) {
+        RenderSettings settings;
+        settings.camera = Above(0.0);
+        settings.width = 200, settings.height = 150;
+        settings.range = {0.0, 1.6 * sun};  // the plate at 5/8 of the scale
+        settings.palette = palette;
+        const Rendering picture = Render(scene, prepared.Rays(), solution, settings);
+        EXPECT_EQ(picture.image.Width(), 200);
+        EXPECT_GT(picture.image.Height(), 150);  // the bar's panel below the view
+        EXPECT_EQ(picture.beyondFraction, 0.0);
+        const Rgb plate = picture.image.At(100, 75);
+        const Rgb bar =
+            picture.image.At(picture.BarColumn(sun), (picture.barTop + picture.barBottom) / 2);
+        // The bar's column holds the value to within half a column (under 1/300 of the
+        // scale here), less than one colour step of either palette.
+        EXPECT_NEAR(plate.r, bar.r, 1) << static_cast<int>(palette);
+        EXPECT_NEAR(plate.g, bar.g, 1);
+        EXPECT_NEAR(plate.b, bar.b, 1);
+        EXPECT_EQ(plate, picture.scale.AtFraction(sun / (1.6 * sun)));
+    }
+}
+
+TEST(Render, APlateWithHalfTheLightIsHalfAsBrightOnTheGreyScale) {
+    const double sun = 300.0;
+    const Scene scene = Plates({0.0, 60.0}, sun);  // cos 60° = 1/2
+    const PreparedScene prepared(scene);
+    const Solution solution = SolveHrc(prepared);
+    RenderSettings settings;
+    settings.camera = {{1.5, 0.0, 31.0}, {1.5, 0.0, 1.0}, {0.0, 1.0, 0.0}, 8.0};
+    settings.width = 320, settings.height = 160;
+    settings.palette = Palette::kGrey;
+    settings.samples = 1;
+    const Rendering picture = Render(scene, prepared.Rays(), solution, settings);
+    // The scale runs from 0 to the brightest value in view, the flat plate's.
+    EXPECT_NEAR(picture.scale.max, sun, 1e-6 * sun);
+    const View view(settings.camera, settings.width, settings.height);
+    // Pixels over each plate's centre: the flat one at x = 0 m and the tilted one at 3 m,
+    // 1.5 m either side of the view's centre; tan(4°)·30 m spans half the view's height.
+    const double metresPerPixel = 2.0 * std::tan(glm::radians(4.0)) * 30.0 / settings.height;
+    const int offset = static_cast<int>(std::lround(1.5 / metresPerPixel));
+    const Rgb flat = picture.image.At(160 - offset, 80),
+              tilted = picture.image.At(160 + offset, 80);
+    EXPECT_EQ(flat.r, 255);
+    // 255 / 2 rounds to 128: the ratio within one grey level.
+    EXPECT_NEAR(static_cast<double>(tilted.r) / flat.r, 0.5, 1.0 / 255.0);
+    EXPECT_EQ(tilted.r, tilted.g);
+}
+
+// The error a camera text gets, as "field: message".
+std::string CameraError(const std::string& text) {
+    try {
+        ParseCamera(text);
+    } catch (const InputError& e) {
+        return e.Field() + ": " + e.Message();
+    }
+    return "accepted";
+}
+
+TEST(Render, ABadCameraIsRefusedNamingItsField) {
+    EXPECT_EQ(CameraError("eye=0,0,10 look=0,0,0 up=0,1,0 fov=30"), "accepted");
+    EXPECT_EQ(CameraError("eye=1,2,3 look=1,2,3").substr(0, 12), "camera.look:");
+    EXPECT_EQ(CameraError("eye=0,0,10 look=0,0,0 up=0,1,0 fov=0").substr(0, 11), "camera.fov:");
+    EXPECT_EQ(CameraError("eye=0,0,10 look=0,0,0 up=0,1,0 fov=180").substr(0, 11), "camera.fov:");
+    EXPECT_EQ(CameraError("eye=nan,0,10 look=0,0,0 up=0,1,0").substr(0, 11), "camera.eye:");
+    EXPECT_EQ(CameraError("eye=0,0,10 look=0,0,0 up=0,0,1").substr(0, 10), "camera.up:");
+    EXPECT_EQ(CameraError("eye=0,0 look=0,0,0").substr(0, 11), "camera.eye:");
+    EXPECT_EQ(CameraError("eye=0,0,10").substr(0, 12), "camera.look:");
+    EXPECT_EQ(CameraError("eye=0,0,10 look=0,0,0 up=0,1,0 zoom=2").substr(0, 12), "camera.zoom:");
+}
+
+TEST(Render, ASolutionReadBackFromItsCsvDrawsTheSamePicture) {
+    const Scene scene = Plates({0.0, 30.0, 60.0}, 500.0);
+    const PreparedScene prepared(scene);
+    const Solution solution = SolveHrc(prepared);
+    const std::string path = ::testing::TempDir() + "render_plates.csv";
+    {
+        std::ofstream out(path);
+        WriteLeafCsv(out, scene, prepared.Flat(), solution);
+    }
+    const Solution read = ReadLeafCsv(path, scene, prepared.Flat());
+    RenderSettings settings;
+    settings.camera = {{3.0, -12.0, 8.0}, {3.0, 0.0, 1.0}, {0.0, 0.0, 1.0}, 35.0};
+    settings.width = 160, settings.height = 120;
+    const Rendering a = Render(scene, prepared.Rays(), solution, settings);
+    const Rendering b = Render(scene, prepared.Rays(), read, settings);
+    EXPECT_EQ(a.scale.max, b.scale.max);
+    for (int y = 0; y < a.image.Height(); ++y)
+        for (int x = 0; x < a.image.Width(); ++x)
+            ASSERT_EQ(a.image.At(x, y), b.image.At(x, y)) << x << "," << y;
+    // And written as PNG, read back pixel for pixel.
+    const std::string png = ::testing::TempDir() + "render_plates.png";
+    WritePng(a.image, png);
+    const Image back = ReadPng(png);
+    ASSERT_EQ(back.Width(), a.image.Width());
+    ASSERT_EQ(back.Height(), a.image.Height());
+    for (int y = 0; y < back.Height(); ++y)
+        for (int x = 0; x < back.Width(); ++x) ASSERT_EQ(back.At(x, y), a.image.At(x, y));
+}
+
+TEST(Render, ACsvThatDoesNotMatchTheSceneIsRefusedNamingItsLine) {
+    const Scene scene = Plates({0.0}, 100.0);
+    const FlatScene flat = Flatten(scene);
+    const std::string path = ::testing::TempDir() + "render_bad.csv";
+    const auto refusal = [&](const std::string& text) -> std::string {
+        std::ofstream(path) << text;
+        try {
+            ReadLeafCsv(path, scene, flat);
+        } catch (const InputError& e) {
+            return e.Field() + ": " + e.Message();
+        }
+        return "accepted";
+    };
+    const std::string header =
+        "organ,band,area_m2,irradiance_upper_wm2,irradiance_lower_wm2,absorbed_w\n";
+    EXPECT_EQ(refusal(header + "plate0,PAR,1,100,0,100\n"), "accepted");
+    EXPECT_EQ(refusal(header + "plate0,PAR,1,100,0,100\nplate9,PAR,1,1,1,1\n"),
+              path + ":3: organ 'plate9' is not in the scene");
+    EXPECT_EQ(refusal(header + "plate0,NIR,1,100,0,100\n"),
+              path + ":2: band 'NIR' is not in the scene");
+    EXPECT_EQ(refusal(header + "plate0,PAR,1,abc,0,100\n"),
+              path + ":2 irradiance_upper_wm2: not a number: 'abc'");
+    EXPECT_EQ(refusal("organ,band\nplate0,PAR\n"), path + ":1: no column irradiance_upper_wm2");
+}
+
+TEST(Render, TicksAreRoundValuesWithinTheScale) {
+    EXPECT_EQ(Ticks(0.0, 483.0, 5), (std::vector<double>{0, 100, 200, 300, 400}));
+    EXPECT_EQ(Ticks(0.0, 1.0, 4), (std::vector<double>{0, 0.5, 1}));
+    const std::vector<double> ticks = Ticks(-20.0, 20.0, 4);
+    EXPECT_EQ(ticks, (std::vector<double>{-20, -10, 0, 10, 20}));
+}
+
+}  // namespace
+}  // namespace leaflux
