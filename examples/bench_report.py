@@ -9,7 +9,7 @@ what the last run measured and nothing else: docs/results.md holds every table (
 per scene), README.md one summary of the error tables (`report:summary`).
 
 Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon,
-                       daemon-accuracy,soak,rays,summary]
+                       daemon-accuracy,soak,rays,render,summary]
                       [--scenes a,b]
                       [--scaling-solvers hrc,mc]
        bench_report.py --tables-only [--only ...]   # rewrite from examples/report/, run nothing
@@ -395,6 +395,31 @@ def soak_section(build, out, run=True):
             f"{mib('rss_after_kb')} at the end (the test fails above +{mib('rss_bound_kb')}).")
 
 
+def render_sections(build, out, run=True):
+    """Runs bench_render.py: pictures of the 119k tree by HRC and by instancing, a plantation
+    and the greenhouse, each drawn from its solve's CSV at 1024 × 768; returns the time
+    table for docs/results.md and the pictures for the README."""
+    if run:
+        subprocess.run([sys.executable, os.path.join(HERE, "bench_render.py"), build, out], check=True)
+        shutil.copy(os.path.join(out, "render.csv"), os.path.join(REPORT, "render.csv"))
+    rows = list(csv.DictReader(open(os.path.join(REPORT, "render.csv"))))
+    if run:
+        for r in rows:
+            shutil.copy(os.path.join(out, r["png"]), os.path.join(REPORT, r["png"]))
+    table = ["| picture | size | rays a pixel | rays | render s | M rays/s | colour scale W/m² |", "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        table.append(f"| {r['picture']} | {r['size']} | {r['pixel_samples']} | {int(r['rays']):,} | "
+                     f"{number(r['render_s'])} | {number(int(r['rays']) / float(r['render_s']) / 1e6)} | "
+                     f"0–{number(r['scale_max'])} |")
+    by = {r["picture"]: r for r in rows}
+    link = lambda name: figure(README, by[name]["png"])
+    pictures = ["| the 119k tree lit by HRC | the same by the instanced solver, one scale |", "|---|---|",
+                f"| ![HRC]({link('tree119k_hrc')}) | ![instanced]({link('tree119k_instanced')}) |", "",
+                "| a plantation of 16 trees | inside the greenhouse at night |", "|---|---|",
+                f"| ![plantation]({link('plantation_hrc')}) | ![greenhouse]({link('greenhouse_hrc')}) |"]
+    return "\n".join(table), "\n".join(pictures)
+
+
 def demo_section():
     """The demo's two plants at their first and last cycles (cycles.csv and plants.csv of
     each run; the wall-hole scenario has one plant)."""
@@ -616,7 +641,7 @@ def main():
                         help="build directory (default: build/release)")
     parser.add_argument("out", nargs="?", default=os.path.join(ROOT, "out", "report"),
                         help="directory of the runs' files (default: out/report)")
-    parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon,daemon-accuracy,soak,rays",
+    parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon,daemon-accuracy,soak,rays,render",
                         help="parts to run (default: all)")
     parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
     parser.add_argument("--scaling-solvers", default="hrc,mc",
@@ -660,6 +685,10 @@ def main():
                daemon_accuracy_section(build, os.path.join(out, "daemon_accuracy"), run))
     if "soak" in parts:
         update(RESULTS, "soak", soak_section(build, os.path.join(out, "soak"), run))
+    if "render" in parts:
+        table, pictures = render_sections(build, os.path.join(out, "render"), run)
+        update(RESULTS, "render", table)
+        update(README, "pictures", pictures)
     if "rays" in parts:
         update(RESULTS, "rays", rays_section(build, os.path.join(out, "rays"), run))
     if "phase-db" in parts:

@@ -1,0 +1,97 @@
+#!/usr/bin/python3
+"""Pictures and render time: `leaflux render` on the 119k tree lit by HRC and by the
+instanced solver (one colour scale for both), on a plantation and inside the greenhouse at
+night. Each scene is solved once (`leaflux solve --out`), then drawn from that CSV
+(`render --from`), so the time is the picture's alone: primary rays, colours, colour bar.
+
+Usage: bench_render.py BUILD_DIR OUT_DIR [--size 1024x768] [--pixel-samples 4]
+Writes OUT_DIR/render.csv (picture, scene, solver, size, rays, render_s, scale_max, png)
+and the pictures OUT_DIR/render_*.png, and prints the table.
+"""
+import argparse
+import csv
+import math
+import os
+import re
+import subprocess
+
+# name: (how to make the scene, the camera)
+SCENES = {
+    "tree119k": (["--leaves", "44500", "--seed", "2", "--sky-cones", "turtle46"],
+                 "eye=20,-22,9 look=0,0,7.5 fov=45"),
+    "plantation": (["--leaves", "2000", "--seed", "2", "--rows", "4", "--columns", "4", "--spacing", "4"],
+                   "eye=14,-18,9 look=0,0,2 fov=45"),
+    "greenhouse": (["--greenhouse", "--rows", "3", "--columns", "8", "--spacing", "0.8", "--row-spacing", "1.4",
+                    "--leaves", "200", "--leaf-length", "0.06"],
+                   "eye=-0.7,-2.9,1.5 look=0.2,2,0.2 fov=70"),
+}
+# The pictures: (name, scene, solver); pictures of one scene share one colour scale.
+PICTURES = [("tree119k_hrc", "tree119k", "hrc"), ("tree119k_instanced", "tree119k", "instanced"),
+            ("plantation_hrc", "plantation", "hrc"), ("greenhouse_hrc", "greenhouse", "hrc")]
+
+
+def render(leaflux, scene, leaves, camera, png, size, samples, scale_max=None):
+    """Draws `leaves` (a solve's CSV) on `scene`; returns (rays, seconds, the scale's top)."""
+    command = [leaflux, "render", "--scene", scene, "--from", leaves, "--camera", camera, "--size", size,
+               "--pixel-samples", str(samples), "--out", png]
+    if scale_max is not None:
+        command += ["--range", f"0,{scale_max}"]
+    text = subprocess.run(command, check=True, capture_output=True, text=True).stdout
+    match = re.search(r"from \S+ to (\S+), (\d+) rays in (\S+) s", text)
+    return int(match.group(2)), float(match.group(3)), float(match.group(1))
+
+
+def round_up(value):
+    """`value` rounded up to three significant digits: a scale's top above every value."""
+    step = 10.0 ** (math.floor(math.log10(value)) - 2)
+    return f"{math.ceil(value / step) * step:.6g}"
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("build", help="the build folder, with server/leaflux")
+    parser.add_argument("out", help="folder of the scenes, render.csv and the pictures (made when missing)")
+    parser.add_argument("--size", default="1024x768", help="the view's size in pixels (default: %(default)s)")
+    parser.add_argument("--pixel-samples", type=int, default=4, help="rays a pixel (default: %(default)s)")
+    args = parser.parse_args()
+    leaflux = os.path.join(args.build, "server", "leaflux")
+    os.makedirs(args.out, exist_ok=True)
+    solved = {}
+    for name, scene_name, solver in PICTURES:
+        scene = os.path.join(args.out, f"{scene_name}.scene.txtpb")
+        if not os.path.exists(scene):
+            subprocess.run([leaflux, "generate", *SCENES[scene_name][0], "--out", scene], check=True,
+                           capture_output=True)
+        leaves = os.path.join(args.out, f"{name}.csv")
+        subprocess.run([leaflux, "solve", "--scene", scene, "--solver", solver, "--quiet", "--out", leaves,
+                        "--phase-db", os.path.join(args.out, "phase.db")] if solver == "instanced" else
+                       [leaflux, "solve", "--scene", scene, "--solver", solver, "--quiet", "--out", leaves],
+                       check=True, capture_output=True)
+        solved[name] = (scene, leaves)
+    # The scale of a scene's pictures: 0 to the largest value any of them has in view.
+    tops = {}
+    for name, scene_name, _ in PICTURES:
+        scene, leaves = solved[name]
+        png = os.path.join(args.out, f"render_{name}.png")
+        top = render(leaflux, scene, leaves, SCENES[scene_name][1], png, args.size, args.pixel_samples)[2]
+        tops[scene_name] = max(tops.get(scene_name, 0.0), top)
+    rows = []
+    for name, scene_name, solver in PICTURES:
+        scene, leaves = solved[name]
+        png = os.path.join(args.out, f"render_{name}.png")
+        rays, seconds, top = render(leaflux, scene, leaves, SCENES[scene_name][1], png, args.size,
+                                    args.pixel_samples, round_up(tops[scene_name]))
+        rows.append({"picture": name, "scene": scene_name, "solver": solver, "size": args.size,
+                     "pixel_samples": args.pixel_samples, "rays": rays, "render_s": seconds,
+                     "scale_max": top, "png": os.path.basename(png)})
+    with open(os.path.join(args.out, "render.csv"), "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    print(f"{'picture':<22}{'size':>10}{'rays':>12}{'render s':>10}{'scale max':>11}")
+    for r in rows:
+        print(f"{r['picture']:<22}{r['size']:>10}{r['rays']:>12,}{r['render_s']:>10.3f}{r['scale_max']:>11.4g}")
+
+
+if __name__ == "__main__":
+    main()
