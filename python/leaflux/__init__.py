@@ -4,7 +4,7 @@
     with LocalDaemon() as daemon, Client(daemon.endpoint) as client:
         session = client.open(scene, pb.SolverSettings(solver=pb.SOLVER_KIND_HRC))
         light = client.cycle(session, 1, added=[...], bands=["PAR"])
-        light.to_csv("cycle1.csv")
+        light.to_csv("out/cycle1.csv")  # its folder made first: os.makedirs("out", exist_ok=True)
 
 `pb` is the protocol's generated module (leaflux_pb2, from proto/leaflux.proto); `policy_pb2`
 is proto/policy.proto's. See docs/python.md.

@@ -74,7 +74,7 @@ void Refiner::Carry(const Task& task, const Verdict& verdict, std::vector<Task>&
         const auto& children = hierarchy_[r].children;
         if (hierarchy_[r].patch || hierarchy_[r].closed >= 0 || model_.Held(r) ||
             children.empty()) {
-            done_ += task.share;
+            done_ += static_cast<double>(task.share);
             return;
         }
         const float share = task.share / static_cast<float>(children.size() * children.size());
@@ -88,10 +88,10 @@ void Refiner::Carry(const Task& task, const Verdict& verdict, std::vector<Task>&
     }
     switch (verdict.kind) {
         case Verdict::kNone:
-            done_ += task.share;
+            done_ += static_cast<double>(task.share);
             return;
         case Verdict::kLink:
-            done_ += task.share;
+            done_ += static_cast<double>(task.share);
             if (task.kind == Task::kSource) {
                 links_.source[r].push_back({s, verdict.visibility});
             } else {

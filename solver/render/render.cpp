@@ -5,10 +5,8 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <limits>
 
 #include "solver/render/legend.h"
 #include "solver/scene/light_units.h"
