@@ -182,6 +182,7 @@ DEMO_FILES = [("growth_comparison.csv", "growth_comparison.csv"), ("growth_compa
               ("instancing_comparison.png", "instancing_comparison.png"),
               ("instancing_above_10_comparison.csv", "instancing_above_10_comparison.csv"),
               ("instanced/cycles.csv", "demo_cycles_instanced.csv"),
+              *[(f"cycle{c}.png", f"demo_cycle{c}.png") for c in (2, 9, 13, 17, 25)],
               ("instanced_above_10/cycles.csv", "demo_cycles_instanced_above_10.csv")]
 
 
@@ -417,7 +418,17 @@ def render_sections(build, out, run=True):
                 f"| ![HRC]({link('tree119k_hrc')}) | ![instanced]({link('tree119k_instanced')}) |", "",
                 "| a plantation of 16 trees | inside the greenhouse at night |", "|---|---|",
                 f"| ![plantation]({link('plantation_hrc')}) | ![greenhouse]({link('greenhouse_hrc')}) |"]
-    return "\n".join(table), "\n".join(pictures)
+    return "\n".join(table), "\n".join(pictures + wall_hole_series())
+
+
+def wall_hole_series():
+    """The demo's wall-hole plant at cycles 2, 9, 13, 17 and 25 (copied by the growth part),
+    for the README's pictures: a table row of five, or nothing before the demo ran."""
+    cycles = [c for c in (2, 9, 13, 17, 25) if os.path.exists(os.path.join(REPORT, f"demo_cycle{c}.png"))]
+    if not cycles:
+        return []
+    return ["", "| " + " | ".join(f"wall-hole, cycle {c}" for c in cycles) + " |", "|---" * len(cycles) + "|",
+            "| " + " | ".join(f"![cycle {c}]({figure(README, f'demo_cycle{c}.png')})" for c in cycles) + " |"]
 
 
 def demo_section():
@@ -675,6 +686,8 @@ def main():
         update(RESULTS, "phase-functions", times)
     if "growth" in parts:
         update(RESULTS, "growth", growth_section(args.demo, run))
+        if "render" not in parts and os.path.exists(os.path.join(REPORT, "render.csv")):
+            update(README, "pictures", render_sections(build, out, run=False)[1])  # the new series
         update(RESULTS, "demo", demo_section())
         update(RESULTS, "growth-instanced", instancing_section())
     if "daemon" in parts:

@@ -32,8 +32,9 @@ int main(int argc, char** argv) {
                    "Output folder: cycles.csv, plants.csv, phytomers.csv (organ masses by "
                    "topological address), cycle<N>.ply");
     app.add_option("--ply-cycles", pictures,
-                   "Cycles whose PLY is written into --out, as numbers separated by commas, "
-                   "e.g. 2,9,13,17,25");
+                   "Cycles whose PLY, scene and light (cycle<N>.scene.txtpb and cycle<N>.csv, "
+                   "for leaflux render --scene ... --from ...) are written into --out, as numbers "
+                   "separated by commas, e.g. 2,9,13,17,25");
     app.add_option("--endpoint", endpoint, "leafluxd's address");
     app.add_option("--curve-server-key", curveKeyFile,
                    "File with leafluxd's CurveZMQ public key (when it has one)")

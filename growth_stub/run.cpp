@@ -1,5 +1,7 @@
 #include "growth_stub/run.h"
 
+#include <google/protobuf/text_format.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -134,6 +136,33 @@ void WritePly(const std::string& path, const Scenario& scenario, const GrowthMod
             << faces[i].lower << '\n';
     }
     if (!out) throw std::runtime_error(path + ": cannot write");
+}
+
+// The scene the daemon solved at this cycle (cycle<N>.scene.txtpb) and the light it sent
+// back for it (cycle<N>.csv, the columns `leaflux solve --out` begins with), so that
+// `leaflux render --scene … --from …` draws the cycle as it was lit.
+void WriteCycleScene(const std::string& stem, const v1::Scene& scene,
+                     const v1::CycleResult& result) {
+    std::string text;
+    google::protobuf::TextFormat::PrintToString(scene, &text);
+    std::ofstream(stem + ".scene.txtpb") << text;
+    std::ofstream csv(stem + ".csv");
+    csv.precision(9);
+    const auto quoted = [](const std::string& name) {
+        if (name.find_first_of(",\"\n") == std::string::npos) return name;
+        std::string q = "\"";
+        for (char c : name) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+        return q + "\"";
+    };
+    csv << "organ,band,area_m2,irradiance_upper_wm2,irradiance_lower_wm2,absorbed_w\n";
+    for (const v1::OrganLight& organ : result.organs()) {
+        for (const v1::BandLight& b : organ.bands()) {
+            csv << quoted(organ.name()) << ',' << quoted(b.band()) << ',' << organ.area_m2() << ','
+                << b.irradiance_upper_wm2() << ',' << b.irradiance_lower_wm2() << ','
+                << b.absorbed_w() << '\n';
+        }
+    }
+    if (!csv) throw std::runtime_error(stem + ".csv: cannot write");
 }
 
 }  // namespace
@@ -275,8 +304,9 @@ std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
                              << '\n';
             }
             if (options.plyCycles.count(c)) {
-                WritePly(options.outDir + "/cycle" + std::to_string(c) + ".ply", scenario, model,
-                         light, result);
+                const std::string stem = options.outDir + "/cycle" + std::to_string(c);
+                WritePly(stem + ".ply", scenario, model, light, result);
+                WriteCycleScene(stem, SessionScene(scenario, model, sent), result);
             }
         }
         if (!options.quiet) {

@@ -15,7 +15,9 @@ namespace leaflux::grow {
 struct RunOptions {
     int cycles = 25;
     std::string outDir;        // cycles.csv, plants.csv, cycle<N>.ply; "" writes nothing
-    std::set<int> plyCycles;   // cycles whose geometry and light are written
+    // Cycles whose geometry and light are written: cycle<N>.ply, and the scene solved and
+    // its light, cycle<N>.scene.txtpb and cycle<N>.csv, for `leaflux render`.
+    std::set<int> plyCycles;
     bool branchLight = false;  // ask for per-axis light only, not per leaf
     bool quiet = false;
 };

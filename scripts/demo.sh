@@ -53,8 +53,15 @@ start_daemon
     --policy proto/policies/above_10_leaves.txtpb --quiet | tee -a "$out/grow.txt"
 stop_daemon
 
+# The pictures, drawn by leaflux render from each cycle's scene and light, on one colour
+# scale: 0 to the most an organ gets on its two sides in any of them (rounded up).
+top=$(awk -F, 'FNR > 1 && $2 == "PAR" { if ($4 + $5 > m) m = $4 + $5 }
+               END { printf "%d", m + 1 }' "$out"/cycle{2,9,13,17,25}.csv)
 for c in 2 9 13 17 25; do
-    /usr/bin/python3 examples/render_ply.py "$out/cycle$c.ply" "$out/cycle$c.png" "wall-hole, cycle $c"
+    "$B/server/leaflux" render --scene "$out/cycle$c.scene.txtpb" --from "$out/cycle$c.csv" \
+        --camera "eye=-0.85,-0.9,0.75 look=0.6,0.05,0.5 fov=60" --side both --size 640x480 \
+        --range "0,$top" \
+        --out "$out/cycle$c.png" > /dev/null
 done
 /usr/bin/python3 examples/plot_growth.py "$out" "full light" "$out/direct_only" "direct light only"
 /usr/bin/python3 examples/compare_growth.py "$out" full "$out/direct_only" direct_only \
@@ -63,7 +70,7 @@ done
     "$out/instancing_comparison"
 /usr/bin/python3 examples/compare_growth.py "$out" hrc "$out/instanced_above_10" \
     instanced_above_10_leaves "$out/instancing_above_10_comparison"
-echo "results in $out/: cycles.csv plants.csv phytomers.csv cycle{2,9,13,17,25}.{ply,png}" \
+echo "results in $out/: cycles.csv plants.csv phytomers.csv cycle{2,9,13,17,25}.{ply,scene.txtpb,csv,png}" \
      "growth.png growth_comparison.{csv,png} instancing_comparison.{csv,png}" \
      "instancing_above_10_comparison.{csv,png} grow.txt direct_only/ instanced/" \
      "instanced_above_10/ leafluxd.log"

@@ -102,6 +102,44 @@ TEST(Render, APlateWithHalfTheLightIsHalfAsBrightOnTheGreyScale) {
     EXPECT_EQ(tilted.r, tilted.g);
 }
 
+// Both sides: an organ's two summed, but a wall's seen side alone (its outside lies in
+// another space than its inside). A grey ground lit from above, seen from below, stays dark;
+// a leaf (ρ = τ = 0.5) beside it shows its two sides' sum.
+TEST(Render, BothSidesSumAnOrgansSidesButNotAWalls) {
+    Scene scene = OneBandScene({{"leaf", Leaf(0.25, 0.25)}, {"ground", Opaque(0.5)}});
+    scene.nodes.push_back(OrganNode(1, "leaf", Rectangle(1.0, 1.0, 1.0), "leaf"));
+    Surface ground;
+    ground.name = "ground";
+    ground.mesh = Quad({2.5, -0.5, 0.0}, {3.5, -0.5, 0.0}, {3.5, 0.5, 0.0}, {2.5, 0.5, 0.0});
+    ground.opticsId = "ground";
+    scene.environment.push_back(ground);
+    scene.sources.suns.push_back(SunAt(90.0, 0.0, 200.0));
+    scene.Validate();
+    const PreparedScene prepared(scene);
+    const Solution solution = SolveHrc(prepared);
+    const BandLight& leaf = solution.light[0][0];
+    ASSERT_GT(leaf.irradianceLowerWm2,
+              0.0);  // the light the leaf lets through, back from the ground
+    RenderSettings settings;
+    settings.camera = {{1.5, 0.0, -30.0}, {1.5, 0.0, 0.5}, {0.0, 1.0, 0.0}, 8.0};  // from below
+    settings.width = 320, settings.height = 160;
+    settings.palette = Palette::kGrey;
+    settings.samples = 1;
+    settings.side = Side::kBothSides;
+    settings.range = {0.0, 400.0};
+    const Rendering picture = Render(scene, prepared.Rays(), solution, settings);
+    const double metresPerPixel = 2.0 * std::tan(glm::radians(4.0)) * 30.5 / settings.height;
+    const int offset = static_cast<int>(std::lround(1.5 / metresPerPixel));
+    // The camera looks up: its right is -x, so the leaf (x = 0) is right of the centre.
+    const Rgb leafPixel = picture.image.At(160 + offset, 80),
+              groundPixel = picture.image.At(160 - offset, 80);
+    EXPECT_EQ(leafPixel, picture.scale.AtFraction(
+                             (leaf.irradianceUpperWm2 + leaf.irradianceLowerWm2) / 400.0));
+    EXPECT_EQ(groundPixel,
+              picture.scale.AtFraction(solution.light[1][0].irradianceLowerWm2 / 400.0));
+    EXPECT_EQ(groundPixel, Rgb{}) << "the ground's underside gets nothing";
+}
+
 // The error a camera text gets, as "field: message".
 std::string CameraError(const std::string& text) {
     try {

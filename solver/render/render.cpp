@@ -50,6 +50,10 @@ double ValueOf(const Scene& scene, const Receiver& receiver, const BandLight& li
         case Side::kLowerSide:
             return SideValue(light, optics, false, settings.quantity);
         case Side::kBothSides:
+            // A wall or a ground bounds two spaces: summing its sides would paint a wall's
+            // sunlit outside onto its inside. It shows the side in view.
+            if (receiver.kind == ReceiverKind::kEnvironment)
+                return SideValue(light, optics, upperSeen, settings.quantity);
             return SideValue(light, optics, true, settings.quantity) +
                    SideValue(light, optics, false, settings.quantity);
     }

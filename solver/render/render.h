@@ -26,7 +26,8 @@ enum class Side {
     kSeenSide,  // the side facing the camera
     kUpperSide,
     kLowerSide,
-    kBothSides,  // the two summed (the error tables' value of a leaf)
+    kBothSides,  // an organ's two summed (the error tables' value of a leaf); an
+                 // environment surface's seen side (its sides face two spaces)
 };
 
 struct RenderSettings {
