@@ -14,7 +14,7 @@ namespace leaflux::grow {
 
 struct RunOptions {
     int cycles = 25;
-    std::string outDir;        // cycles.csv, plants.csv, cycle<N>.ply; "" writes nothing
+    std::string outDir;  // cycles.csv, plants.csv, cycle<N>.ply; "" writes nothing
     // Cycles whose geometry and light are written: cycle<N>.ply, and the scene solved and
     // its light, cycle<N>.scene.txtpb and cycle<N>.csv, for `leaflux render`.
     std::set<int> plyCycles;

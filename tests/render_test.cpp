@@ -150,6 +150,22 @@ std::string CameraError(const std::string& text) {
     return "accepted";
 }
 
+TEST(Render, APictureTooLargeToHoldIsRefusedBeforeAnyRay) {
+    const Scene scene = Plates({0.0}, 100.0);
+    RenderSettings settings;
+    settings.camera = Above(0.0);
+    settings.width = settings.height = 16384;
+    settings.samples = 16;  // 2^32 rays
+    try {
+        Validate(settings, scene);
+        ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.Field(), "samples");
+    }
+    settings.samples = 1;  // 2^28 rays: the most a picture may take
+    EXPECT_NO_THROW(Validate(settings, scene));
+}
+
 TEST(Render, ABadCameraIsRefusedNamingItsField) {
     EXPECT_EQ(CameraError("eye=0,0,10 look=0,0,0 up=0,1,0 fov=30"), "accepted");
     EXPECT_EQ(CameraError("eye=1,2,3 look=1,2,3").substr(0, 12), "camera.look:");

@@ -15,6 +15,7 @@
 namespace leaflux {
 namespace {
 
+constexpr long long kMaxRays = 1LL << 28;
 constexpr Rgb kSky{232, 236, 240};       // where a ray leaves the scene
 constexpr Rgb kLamp{255, 244, 214};      // an emitter's own surface
 constexpr Rgb kUnsolved{150, 150, 150};  // an organ of a structure solved whole
@@ -86,6 +87,14 @@ void Validate(const RenderSettings& settings, const Scene& scene) {
     }
     if (settings.samples < 1 || settings.samples > 1024)
         throw InputError(ErrorCode::kInvalidArgument, "samples", "must be from 1 to 1024");
+    // Every ray's value is kept until the scale is known (8 bytes each): at most 2 GiB.
+    const double rays = static_cast<double>(settings.width) * settings.height * settings.samples;
+    if (rays > kMaxRays) {
+        throw InputError(ErrorCode::kInvalidArgument, "samples",
+                         "size x samples makes " + std::to_string(static_cast<long long>(rays)) +
+                             " rays, over the " + std::to_string(kMaxRays) +
+                             " a picture may take; fewer pixels or samples");
+    }
     if (settings.band < 0 || settings.band >= static_cast<int>(scene.bands.size()))
         throw InputError(ErrorCode::kNotFound, "band", "not a band of the scene");
     if (settings.photons && !PhotonUmolPerJ(scene.bands[settings.band])) {
