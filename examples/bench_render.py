@@ -3,6 +3,11 @@
 instanced solver (one colour scale for both), on a plantation and inside the greenhouse at
 night. Each scene is solved once (`leaflux solve --out`), then drawn from that CSV
 (`render --from`), so the time is the picture's alone: primary rays, colours, colour bar.
+Then the instanced solver opening only the instances in view (`render --open-in-view`)
+against opening them all, on the plantation seen from its edge and on a close-up of the
+119k tree's crown, from the phase functions the first pictures stored: instances opened,
+solve time and peak memory, and how far the two pictures are apart on the linear grey
+scale (render_culling.csv).
 
 Usage: bench_render.py BUILD_DIR OUT_DIR [--size 1024x768] [--pixel-samples 4]
 Writes OUT_DIR/render.csv (picture, scene, solver, size, rays, render_s, scale_max, png)
@@ -39,6 +44,42 @@ def render(leaflux, scene, leaves, camera, png, size, samples, scale_max=None):
     text = subprocess.run(command, check=True, capture_output=True, text=True).stdout
     match = re.search(r"from \S+ to (\S+), (\d+) rays in (\S+) s", text)
     return int(match.group(2)), float(match.group(3)), float(match.group(1))
+
+
+# Views that see part of a scene: (name, scene, camera).
+CULLING = [("plantation_edge", "plantation", "eye=-6,-12,2.5 look=-6,-6,2.5 fov=30"),
+           ("tree119k_crown", "tree119k", "eye=3,-4,8 look=2,0,8 fov=35")]
+
+
+def culling_rows(leaflux, out, size, samples):
+    """Each CULLING view solved by the instanced solver twice, opening every instance and
+    those in view alone; the two pictures on one grey scale, compared pixel by pixel."""
+    import matplotlib.image
+    rows = []
+    for name, scene_name, camera in CULLING:
+        scene = os.path.join(out, f"{scene_name}.scene.txtpb")
+        runs = {}
+        for how, flag in (("all", []), ("in_view", ["--open-in-view"])):
+            png = os.path.join(out, f"culling_{name}_{how}.png")
+            text = subprocess.run([leaflux, "render", "--scene", scene, "--solver", "instanced", "--phase-db",
+                                   os.path.join(out, "phase.db"), "--camera", camera, "--size", size,
+                                   "--pixel-samples", str(samples), "--palette", "grey", "--range", "0,500",
+                                   "--out", png, *flag], check=True, capture_output=True, text=True).stdout
+            depths = re.search(r"instances by depth \(opened\):(.*?)(;|\n)", text).group(1)
+            pairs = re.findall(r"\d+: (\d+) \((\d+)\)", depths)
+            solving = float(re.search(r"solving (\S+) s", text).group(1))
+            peak = float(re.search(r"peak (\S+) MiB", text).group(1))
+            runs[how] = (sum(int(a) for a, _ in pairs), sum(int(b) for _, b in pairs), solving, peak, png)
+        a = matplotlib.image.imread(runs["all"][4])[..., 0]
+        b = matplotlib.image.imread(runs["in_view"][4])[..., 0]
+        height = int(size.split("x")[1])  # the view, not the colour bar below it
+        delta = abs(a[:height] - b[:height])  # grey levels / 255: W/m² / 500
+        rows.append({"view": name, "instances": runs["all"][0], "opened_all": runs["all"][1],
+                     "opened_in_view": runs["in_view"][1], "solve_s_all": runs["all"][2],
+                     "solve_s_in_view": runs["in_view"][2], "peak_mib_all": runs["all"][3],
+                     "peak_mib_in_view": runs["in_view"][3], "mean_abs_wm2": 500.0 * float(delta.mean()),
+                     "pixels_apart_pct": 100.0 * float((delta > 1.5 / 255).mean())})
+    return rows
 
 
 def round_up(value):
@@ -91,6 +132,16 @@ def main():
     print(f"{'picture':<22}{'size':>10}{'rays':>12}{'render s':>10}{'scale max':>11}")
     for r in rows:
         print(f"{r['picture']:<22}{r['size']:>10}{r['rays']:>12,}{r['render_s']:>10.3f}{r['scale_max']:>11.4g}")
+    culling = culling_rows(leaflux, args.out, args.size, args.pixel_samples)
+    with open(os.path.join(args.out, "render_culling.csv"), "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(culling[0]))
+        writer.writeheader()
+        writer.writerows(culling)
+    for r in culling:
+        print(f"{r['view']}: {r['opened_in_view']} of {r['instances']} instances opened in view "
+              f"(all: {r['opened_all']}); solve {r['solve_s_in_view']:.2f} s against {r['solve_s_all']:.2f} s, "
+              f"peak {r['peak_mib_in_view']:.0f} against {r['peak_mib_all']:.0f} MiB; pictures apart by "
+              f"{r['mean_abs_wm2']:.3g} W/m² on average, {r['pixels_apart_pct']:.2g} % of pixels by more than a grey level")
 
 
 if __name__ == "__main__":

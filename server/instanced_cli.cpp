@@ -70,6 +70,7 @@ Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene*
     options.hrc = hrc;
     options.hrc.directionalInstances = !command.singleValue;
     options.maxDepth = command.maxDepth;
+    options.inView = command.inView;
     if (!command.outputLevel.empty()) {
         options.outputLevel = command.outputLevel == "plant"  ? NodeType::kPlant
                               : command.outputLevel == "axis" ? NodeType::kAxis

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <functional>
 #include <string>
 
 #include "solver/instancing/instanced.h"
@@ -19,6 +20,8 @@ struct InstancedCommand {
     std::string problems;  // CSV of the local problems solved
     int maxDepth = 0;
     std::string outputLevel;  // "", "plant", "axis" or "phytomer"
+    // Set by leaflux render --open-in-view (InstancedOptions::inView).
+    std::function<bool(const glm::dvec3&, const glm::dvec3&)> inView;
 };
 
 // Adds the instanced solver's options to `solve`.

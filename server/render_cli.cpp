@@ -110,6 +110,9 @@ CLI::App* AddRenderCommand(CLI::App& app, RenderCommand& command) {
         ->add_option("--palette", command.palette,
                      "viridis, or grey (black to white, linear: pixel ratios are value ratios)")
         ->check(CLI::IsMember({"viridis", "grey"}));
+    render->add_flag("--open-in-view", command.openInView,
+                     "instanced: open only the instances whose boxes are in view (Soler 2003 "
+                     "§7.1); the others are solved whole, from their phase functions");
     render
         ->add_option("--pixel-samples", command.pixelSamples,
                      "Rays a pixel, on a stratified grid (rounded to a square: 1, 4, 9, 16, …)")
@@ -128,7 +131,23 @@ int RunRender(const RenderCommand& command) {
     std::unique_ptr<SolvedScene> solved;
     const auto check = [&](const Scene& scene) { SettingsOf(command, scene); };
     if (command.from.empty()) {
-        solved = SolveScene(command.solve, check);
+        SolveCommand solve = command.solve;
+        if (command.openInView) {
+            if (solve.solver != "instanced")
+                throw InputError(ErrorCode::kInvalidArgument, "--open-in-view",
+                                 "is for --solver instanced");
+            const RenderSettings settings = [&] {
+                RenderSettings s;
+                s.camera = ParseCamera(command.camera);
+                std::tie(s.width, s.height) = ParseSize(command.size);
+                return s;
+            }();
+            const View view(settings.camera, settings.width, settings.height);
+            solve.instanced.inView = [view](const glm::dvec3& low, const glm::dvec3& high) {
+                return view.MaySee(low, high);
+            };
+        }
+        solved = SolveScene(solve, check);
     } else {
         solved = std::make_unique<SolvedScene>();
         solved->scene = LoadSceneFile(command.solve.scene, ImportOptions{command.solve.strict});

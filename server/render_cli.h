@@ -14,7 +14,7 @@ struct RenderCommand {
     std::string camera, size = "1024x768", out, from, quantity = "irradiance", side = "seen", band,
                         range, palette = "viridis";
     int pixelSamples = 4;
-    bool photons = false;
+    bool photons = false, openInView = false;
 };
 
 CLI::App* AddRenderCommand(CLI::App& app, RenderCommand& command);

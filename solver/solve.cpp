@@ -40,8 +40,8 @@ Solution Solve(const PreparedScene& prepared, const SolverSettings& settings) {
             std::optional<PhaseDatabase> own;
             PhaseDatabase* database = instanced.database;
             if (database == nullptr) database = &own.emplace(PhaseDatabaseOptions{});
-            InstancedOptions options{settings.hrc, instanced.originals, instanced.maxDepth,
-                                     instanced.outputLevel};
+            InstancedOptions options{
+                settings.hrc, instanced.originals, instanced.maxDepth, instanced.outputLevel, {}};
             InstancedSolution solved =
                 SolveInstanced(prepared.Source(), prepared.Flat(),
                                instanced.shadowsByGeometry ? &prepared.Rays() : nullptr,

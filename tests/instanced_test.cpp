@@ -132,6 +132,44 @@ TEST(Instanced, ExactCopiesLightTheirLeavesAsTheFlattenedScene) {
     }
 }
 
+// Opening only the instances in view (InstancedOptions::inView, leaflux render
+// --open-in-view): the copies it rejects are solved whole, their organs unsolved, and the
+// copies it opens get exactly the light they get when every copy is opened (each copy's
+// problem is its own, from the light that arrived on it).
+TEST(Instanced, OpeningOnlyTheCopiesInViewLeavesTheirLightAsItWas) {
+    const Scene scene = Copies(4, 120);
+    const PreparedScene prepared(scene);
+    PhaseDatabase database({});
+    InstancedOptions options;
+    options.hrc.epsilon = 1e-4;
+    const InstancedSolution all =
+        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+    // The copies stand at x = 0, 1.2, 2.4 and 3.6 m: "in view", the first two.
+    options.inView = [](const glm::dvec3& low, const glm::dvec3& high) {
+        return 0.5 * (low.x + high.x) < 1.8;
+    };
+    const InstancedSolution some =
+        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+    EXPECT_EQ(some.stats.depths[1].opened, 2);
+    EXPECT_EQ(some.stats.depths[1].whole, 2);
+    std::size_t solved = 0, unsolved = 0;
+    for (std::size_t r = 0; r < prepared.Flat().receivers.size(); ++r) {
+        if (prepared.Flat().receivers[r].kind != ReceiverKind::kOrgan) continue;
+        if (some.solution.unsolved[r]) {
+            ++unsolved;
+            continue;
+        }
+        ++solved;
+        for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+            EXPECT_EQ(some.solution.light[r][b].irradianceUpperWm2,
+                      all.solution.light[r][b].irradianceUpperWm2);
+            EXPECT_EQ(some.solution.light[r][b].irradianceLowerWm2,
+                      all.solution.light[r][b].irradianceLowerWm2);
+        }
+    }
+    EXPECT_EQ(solved, unsolved);  // two copies of four
+}
+
 // Light per plant, the plants never opened (outputLevel): each copy's absorbed power is
 // what its phase function and transmittance make of the light that arrived on its box, and
 // that is what its leaves absorb in the flattened scene's HRC.

@@ -140,6 +140,18 @@ TEST(Render, BothSidesSumAnOrgansSidesButNotAWalls) {
     EXPECT_EQ(groundPixel, Rgb{}) << "the ground's underside gets nothing";
 }
 
+// The view's box test: a box ahead is seen, one behind the eye or beside the picture is
+// not, and one the picture's edge crosses is kept.
+TEST(Render, TheViewSeesTheBoxesAheadOfItAndNotThoseBehindOrBeside) {
+    const View view({{0.0, 0.0, 0.0}, {0.0, 10.0, 0.0}, {0.0, 0.0, 1.0}, 40.0}, 400, 300);
+    EXPECT_TRUE(view.MaySee({-1, 9, -1}, {1, 11, 1}));
+    EXPECT_FALSE(view.MaySee({-1, -11, -1}, {1, -9, 1}));     // behind
+    EXPECT_FALSE(view.MaySee({9, 9, -1}, {11, 11, 1}));       // right of a 52° wide view
+    EXPECT_FALSE(view.MaySee({-1, 9, 6}, {1, 11, 8}));        // above a 40° high one
+    EXPECT_TRUE(view.MaySee({3, 9, -1}, {6, 11, 1}));         // across its right edge
+    EXPECT_TRUE(view.MaySee({-50, -50, -50}, {50, 50, 50}));  // round the eye
+}
+
 // The error a camera text gets, as "field: message".
 std::string CameraError(const std::string& text) {
     try {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <glm/gtc/matrix_transform.hpp>
+#include <limits>
 #include <mutex>
 #include <numbers>
 #include <tuple>
@@ -119,8 +120,9 @@ class InstancedSolve {
     std::vector<DirectionalSource> ArrivedOn(const LevelSolution& light, std::size_t c) const;
     void HoldSurfaces(const std::vector<LevelSolution::SurfacePatch>& surfaces);
     void OpenInstances(const Level& level, const LevelSolution& light);
-    // Whether part q is opened (InstancedOptions::maxDepth, outputLevel).
-    bool Opens(std::uint32_t q) const;
+    // Whether part q, placed by worldFromRoot, is opened (InstancedOptions::maxDepth,
+    // outputLevel, inView).
+    bool Opens(std::uint32_t q, const glm::dmat4& worldFromRoot) const;
     bool HoldsInstanceOf(std::uint32_t q, NodeType type) const;
     // Closed instance c of `level` solved whole from the light that arrived on it.
     void SolveWhole(const Level& level, const LevelSolution& light, std::size_t c);
@@ -344,7 +346,7 @@ std::vector<DirectionalSource> InstancedSolve::ArrivedOn(const LevelSolution& li
 void InstancedSolve::OpenInstances(const Level& level, const LevelSolution& light) {
     std::vector<std::size_t> opened;
     for (std::size_t c = 0; c < level.closed.size(); ++c) {
-        if (Opens(level.closedPart[c])) {
+        if (Opens(level.closedPart[c], level.worldFromClosed[c])) {
             opened.push_back(c);
         } else {
             SolveWhole(level, light, c);
@@ -365,8 +367,20 @@ bool InstancedSolve::HoldsInstanceOf(std::uint32_t q, NodeType type) const {
     return false;
 }
 
-bool InstancedSolve::Opens(std::uint32_t q) const {
+bool InstancedSolve::Opens(std::uint32_t q, const glm::dmat4& worldFromRoot) const {
     if (options_.maxDepth > 0 && tree_[q].depth > options_.maxDepth) return false;
+    if (options_.inView) {
+        glm::dvec3 low(std::numeric_limits<double>::infinity()), high(-low);
+        for (int corner = 0; corner < 8; ++corner) {
+            const glm::dvec3 local(corner & 1 ? tree_[q].boxMax.x : tree_[q].boxMin.x,
+                                   corner & 2 ? tree_[q].boxMax.y : tree_[q].boxMin.y,
+                                   corner & 4 ? tree_[q].boxMax.z : tree_[q].boxMin.z);
+            const glm::dvec3 world(worldFromRoot * glm::dvec4(local, 1.0));
+            low = glm::min(low, world);
+            high = glm::max(high, world);
+        }
+        if (!options_.inView(low, high)) return false;
+    }
     return !options_.outputLevel || HoldsInstanceOf(q, *options_.outputLevel);
 }
 

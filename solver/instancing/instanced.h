@@ -34,6 +34,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -60,6 +61,10 @@ struct InstancedOptions {
     // leaves' irradiances are not solved.
     int maxDepth = 0;
     std::optional<NodeType> outputLevel;
+    // When set, an instance opens only if this accepts its box in the world (the bounds of
+    // its box's corners): a picture opens only the instances in view (Soler 2003 §7.1,
+    // leaflux render). The others are solved whole, as beyond maxDepth.
+    std::function<bool(const glm::dvec3& worldMin, const glm::dvec3& worldMax)> inView;
 };
 
 struct InstancedStats {

@@ -1,7 +1,9 @@
 #include "solver/render/camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <iterator>
 #include <sstream>
 
 #include "solver/util/error.h"
@@ -109,6 +111,26 @@ View::View(const Camera& camera, int width, int height)
     const double pixel = std::tan(0.5 * glm::radians(camera.fovDeg)) / halfHeight_;
     right_ = right * pixel;
     down_ = -up * pixel;
+}
+
+bool View::MaySee(const glm::dvec3& boxMin, const glm::dvec3& boxMax) const {
+    // Each corner against the eye's plane and the four planes through the eye and the
+    // picture's edges; the box is out when one plane has every corner outside it.
+    const double tanX = glm::length(right_) * halfWidth_, tanY = glm::length(down_) * halfHeight_;
+    const glm::dvec3 right = glm::normalize(right_), down = glm::normalize(down_);
+    int outside[5] = {0, 0, 0, 0, 0};
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec3 p(corner & 1 ? boxMax.x : boxMin.x, corner & 2 ? boxMax.y : boxMin.y,
+                           corner & 4 ? boxMax.z : boxMin.z);
+        const glm::dvec3 d = p - eye_;
+        const double z = glm::dot(d, forward_), x = glm::dot(d, right), y = glm::dot(d, down);
+        outside[0] += z <= 0.0;
+        outside[1] += x > z * tanX;
+        outside[2] += x < -z * tanX;
+        outside[3] += y > z * tanY;
+        outside[4] += y < -z * tanY;
+    }
+    return std::none_of(std::begin(outside), std::end(outside), [](int n) { return n == 8; });
 }
 
 glm::dvec3 View::Direction(double x, double y) const {

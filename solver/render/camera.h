@@ -31,6 +31,10 @@ class View {
     // (pixel (i, j) covers [i, i + 1) × [j, j + 1)).
     glm::dvec3 Direction(double x, double y) const;
     const glm::dvec3& Eye() const { return eye_; }
+    // Whether a world box may be in view: false only when all its corners lie behind the
+    // eye or beyond one side of the picture (conservative: a box near a corner of the view
+    // may be kept though unseen).
+    bool MaySee(const glm::dvec3& boxMin, const glm::dvec3& boxMax) const;
 
   private:
     glm::dvec3 eye_, forward_, right_, down_;  // right_ and down_ span one pixel each
