@@ -115,14 +115,14 @@ int main(int argc, char** argv) {
     // Grows the tree of `leaves` in a session of `settings` over kCycles cycles; returns
     // the session.
     constexpr int kCycles = 10;
-    auto grow = [&](Loopback& daemon, const char* what, int leaves,
+    auto grow = [&](Loopback& to, const char* what, int leaves,
                     const v1::SolverSettings& settings) {
         std::vector<v1::Node> nodes;
         v1::Request open;
         *open.mutable_open_session()->mutable_scene() = TreeScene(leaves, nodes);
         *open.mutable_open_session()->mutable_settings() = settings;
         open.mutable_open_session()->set_species("generated-tree");
-        const std::string session = daemon.Call(open).opened().session();
+        const std::string session = to.Call(open).opened().session();
         std::size_t next = 0;
         for (int c = 1; c <= kCycles; ++c) {
             v1::Request request;
@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
             const std::size_t until = nodes.size() * c / kCycles;
             for (; next < until; ++next) *cycle->mutable_delta()->add_added() = nodes[next];
             const auto start = Clock::now();
-            const v1::Reply reply = daemon.Call(request);
+            const v1::Reply reply = to.Call(request);
             const v1::SolveStatistics& stats = reply.cycle().statistics();
             rows.push_back({what, leaves, settings.epsilon(), c, reply.cycle().organs_size(),
                             1e3 * Seconds(start), 1e3 * stats.wall_seconds(),
