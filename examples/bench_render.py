@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Pictures and render time: `leaflux render` on the 119k tree lit by HRC and by the
-instanced solver (one colour scale for both), on a plantation and inside the greenhouse at
-night. Each scene is solved once (`leaflux solve --out`), then drawn from that CSV
+instanced solver (one colour scale for both), on a plantation (also in true colour from its
+R, G, B bands, with a scale bar and a north arrow) and inside the greenhouse at night. Each scene is solved once (`leaflux solve --out`), then drawn from that CSV
 (`render --from`), so the time is the picture's alone: primary rays, colours, colour bar.
 Then the instanced solver opening only the instances in view (`render --open-in-view`)
 against opening them all, on the plantation seen from its edge and on a close-up of the
@@ -26,19 +26,23 @@ SCENES = {
                  "eye=20,-22,9 look=0,0,7.5 fov=45"),
     "plantation": (["--leaves", "2000", "--seed", "2", "--rows", "4", "--columns", "4", "--spacing", "4"],
                    "eye=14,-18,9 look=0,0,2 fov=45"),
+    "plantation_rgb": (["--leaves", "2000", "--seed", "2", "--rows", "4", "--columns", "4", "--spacing", "4",
+                        "--colour-bands"], "eye=14,-18,9 look=0,0,2 fov=45"),
     "greenhouse": (["--greenhouse", "--rows", "3", "--columns", "8", "--spacing", "0.8", "--row-spacing", "1.4",
                     "--leaves", "200", "--leaf-length", "0.06"],
                    "eye=-0.7,-2.9,1.5 look=0.2,2,0.2 fov=70"),
 }
-# The pictures: (name, scene, solver); pictures of one scene share one colour scale.
-PICTURES = [("tree119k_hrc", "tree119k", "hrc"), ("tree119k_instanced", "tree119k", "instanced"),
-            ("plantation_hrc", "plantation", "hrc"), ("greenhouse_hrc", "greenhouse", "hrc")]
+# The pictures: (name, scene, solver, what to draw); pictures of one scene share one colour
+# scale.
+PICTURES = [("tree119k_hrc", "tree119k", "hrc", []), ("tree119k_instanced", "tree119k", "instanced", []),
+            ("plantation_hrc", "plantation", "hrc", []), ("greenhouse_hrc", "greenhouse", "hrc", []),
+            ("plantation_colour", "plantation_rgb", "hrc", ["--quantity", "colour", "--scale-bar", "--north-arrow"])]
 
 
-def render(leaflux, scene, leaves, camera, png, size, samples, scale_max=None):
+def render(leaflux, scene, leaves, camera, png, size, samples, what, scale_max=None):
     """Draws `leaves` (a solve's CSV) on `scene`; returns (rays, seconds, the scale's top)."""
     command = [leaflux, "render", "--scene", scene, "--from", leaves, "--camera", camera, "--size", size,
-               "--pixel-samples", str(samples), "--out", png]
+               "--pixel-samples", str(samples), "--out", png, *what]
     if scale_max is not None:
         command += ["--range", f"0,{scale_max}"]
     text = subprocess.run(command, check=True, capture_output=True, text=True).stdout
@@ -98,7 +102,7 @@ def main():
     leaflux = os.path.join(args.build, "server", "leaflux")
     os.makedirs(args.out, exist_ok=True)
     solved = {}
-    for name, scene_name, solver in PICTURES:
+    for name, scene_name, solver, _ in PICTURES:
         scene = os.path.join(args.out, f"{scene_name}.scene.txtpb")
         if not os.path.exists(scene):
             subprocess.run([leaflux, "generate", *SCENES[scene_name][0], "--out", scene], check=True,
@@ -111,17 +115,17 @@ def main():
         solved[name] = (scene, leaves)
     # The scale of a scene's pictures: 0 to the largest value any of them has in view.
     tops = {}
-    for name, scene_name, _ in PICTURES:
+    for name, scene_name, _, what in PICTURES:
         scene, leaves = solved[name]
         png = os.path.join(args.out, f"render_{name}.png")
-        top = render(leaflux, scene, leaves, SCENES[scene_name][1], png, args.size, args.pixel_samples)[2]
+        top = render(leaflux, scene, leaves, SCENES[scene_name][1], png, args.size, args.pixel_samples, what)[2]
         tops[scene_name] = max(tops.get(scene_name, 0.0), top)
     rows = []
-    for name, scene_name, solver in PICTURES:
+    for name, scene_name, solver, what in PICTURES:
         scene, leaves = solved[name]
         png = os.path.join(args.out, f"render_{name}.png")
         rays, seconds, top = render(leaflux, scene, leaves, SCENES[scene_name][1], png, args.size,
-                                    args.pixel_samples, round_up(tops[scene_name]))
+                                    args.pixel_samples, what, round_up(tops[scene_name]))
         rows.append({"picture": name, "scene": scene_name, "solver": solver, "size": args.size,
                      "pixel_samples": args.pixel_samples, "rays": rays, "render_s": seconds,
                      "scale_max": top, "png": os.path.basename(png)})

@@ -398,11 +398,12 @@ def soak_section(build, out, run=True):
 
 def render_sections(build, out, run=True):
     """Runs bench_render.py: pictures of the 119k tree by HRC and by instancing, a plantation
-    and the greenhouse, each drawn from its solve's CSV at 1024 × 768; returns the time
+    (in false and true colour) and the greenhouse, each drawn from its solve's CSV at 1024 × 768; returns the time
     table for docs/results.md and the pictures for the README."""
     if run:
         subprocess.run([sys.executable, os.path.join(HERE, "bench_render.py"), build, out], check=True)
-        shutil.copy(os.path.join(out, "render.csv"), os.path.join(REPORT, "render.csv"))
+        for name in ("render.csv", "render_culling.csv"):
+            shutil.copy(os.path.join(out, name), os.path.join(REPORT, name))
     rows = list(csv.DictReader(open(os.path.join(REPORT, "render.csv"))))
     if run:
         for r in rows:
@@ -416,9 +417,28 @@ def render_sections(build, out, run=True):
     link = lambda name: figure(README, by[name]["png"])
     pictures = ["| the 119k tree lit by HRC | the same by the instanced solver, one scale |", "|---|---|",
                 f"| ![HRC]({link('tree119k_hrc')}) | ![instanced]({link('tree119k_instanced')}) |", "",
-                "| a plantation of 16 trees | inside the greenhouse at night |", "|---|---|",
-                f"| ![plantation]({link('plantation_hrc')}) | ![greenhouse]({link('greenhouse_hrc')}) |"]
-    return "\n".join(table), "\n".join(pictures + wall_hole_series())
+                "| a plantation of 16 trees | the same in true colour (its R, G, B bands) | "
+                "inside the greenhouse at night |", "|---|---|---|",
+                f"| ![plantation]({link('plantation_hrc')}) | ![true colour]({link('plantation_colour')}) | "
+                f"![greenhouse]({link('greenhouse_hrc')}) |"]
+    return "\n".join(table), "\n".join(pictures + wall_hole_series()), culling_table()
+
+
+def culling_table():
+    """The instanced solver opening only the instances in view (render --open-in-view)
+    against opening them all (render_culling.csv), for docs/results.md."""
+    path = os.path.join(REPORT, "render_culling.csv")
+    if not os.path.exists(path):
+        return "(run `bench_report.py --only render`)"
+    table = ["| view | instances | opened, all | opened, in view | solve s, all | solve s, in view | "
+             "peak MiB, all | peak MiB, in view | mean difference W/m² | pixels apart by > 1 grey level |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in csv.DictReader(open(path)):
+        table.append(f"| {r['view']} | {int(r['instances']):,} | {int(r['opened_all']):,} | "
+                     f"{int(r['opened_in_view']):,} | {number(r['solve_s_all'])} | {number(r['solve_s_in_view'])} | "
+                     f"{number(r['peak_mib_all'])} | {number(r['peak_mib_in_view'])} | "
+                     f"{number(r['mean_abs_wm2'])} | {number(r['pixels_apart_pct'])} % |")
+    return "\n".join(table)
 
 
 def wall_hole_series():
@@ -699,8 +719,9 @@ def main():
     if "soak" in parts:
         update(RESULTS, "soak", soak_section(build, os.path.join(out, "soak"), run))
     if "render" in parts:
-        table, pictures = render_sections(build, os.path.join(out, "render"), run)
+        table, pictures, culling = render_sections(build, os.path.join(out, "render"), run)
         update(RESULTS, "render", table)
+        update(RESULTS, "render-culling", culling)
         update(README, "pictures", pictures)
     if "rays" in parts:
         update(RESULTS, "rays", rays_section(build, os.path.join(out, "rays"), run))

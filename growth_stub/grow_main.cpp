@@ -15,7 +15,7 @@ int main(int argc, char** argv) {
     CLI::App app{"leaflux-grow: the reference growth model, a client of leafluxd"};
     app.option_defaults()->always_capture_default();  // --help shows every default
     std::string scenarioPath, endpoint = "tcp://127.0.0.1:5555", curveKeyFile, solver, pictures,
-                              policyFile;
+                              pngs, policyFile;
     grow::RunOptions options;
     int cycles = 0;
     double epsilon = 0.0, spacing = 0.0, rowAzimuth = -1.0;
@@ -35,6 +35,10 @@ int main(int argc, char** argv) {
                    "Cycles whose PLY, scene and light (cycle<N>.scene.txtpb and cycle<N>.csv, "
                    "for leaflux render --scene ... --from ...) are written into --out, as numbers "
                    "separated by commas, e.g. 2,9,13,17,25");
+    app.add_option("--png-cycles", pngs,
+                   "Cycles whose picture leafluxd draws into --out as cycle<N>.png, with the "
+                   "scenario's picture settings (camera, size, scale: one for every cycle), "
+                   "e.g. 2,9,13,17,25");
     app.add_option("--endpoint", endpoint, "leafluxd's address");
     app.add_option("--curve-server-key", curveKeyFile,
                    "File with leafluxd's CurveZMQ public key (when it has one)")
@@ -91,6 +95,18 @@ int main(int argc, char** argv) {
         options.plyCycles = grow::CycleList(pictures, "--ply-cycles");
         if (!options.plyCycles.empty() && options.outDir.empty())
             throw std::invalid_argument("--ply-cycles: the pictures need a folder: give --out");
+        options.pngCycles = grow::CycleList(pngs, "--png-cycles");
+        if (!options.pngCycles.empty()) {
+            if (options.outDir.empty())
+                throw std::invalid_argument("--png-cycles: the pictures need a folder: give --out");
+            if (!scenario.has_picture())
+                throw std::invalid_argument("--png-cycles: scenario " + scenario.name() +
+                                            " has no picture block (its camera, size and scale)");
+            if (options.branchLight)
+                throw std::invalid_argument(
+                    "--png-cycles: the pictures show each organ's light, which --branch-light "
+                    "does not ask for");
+        }
         v1::SolverSettings& settings = *scenario.mutable_settings();
         if (solver == "hrc") settings.set_solver(v1::SOLVER_KIND_HRC);
         if (solver == "mc") settings.set_solver(v1::SOLVER_KIND_MONTE_CARLO);

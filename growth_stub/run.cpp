@@ -308,6 +308,15 @@ std::vector<CycleRecord> Run(const Scenario& scenario, GrowthModel& model,
                 WritePly(stem + ".ply", scenario, model, light, result);
                 WriteCycleScene(stem, SessionScene(scenario, model, sent), result);
             }
+            if (options.pngCycles.count(c)) {
+                v1::RenderRequest render = scenario.picture();
+                render.set_session(session);
+                if (render.band().empty()) render.set_band(scenario.par_band());
+                const std::string path = options.outDir + "/cycle" + std::to_string(c) + ".png";
+                std::ofstream png(path, std::ios::binary);
+                png << client.Render(render).png();
+                if (!png) throw std::runtime_error(path + ": cannot write the picture");
+            }
         }
         if (!options.quiet) {
             std::printf(

@@ -1,6 +1,7 @@
 // leaflux-grow's cycle loop: the growth model on one side, leafluxd on the other, and only
 // the protocol between them. Each cycle sends the delta of the plants, reads the light,
-// writes the cycle's rows and, at chosen cycles, a PLY of the plants with their light.
+// writes the cycle's rows and, at chosen cycles, a PLY of the plants with their light and a
+// picture the daemon draws.
 #pragma once
 
 #include <set>
@@ -18,6 +19,8 @@ struct RunOptions {
     // Cycles whose geometry and light are written: cycle<N>.ply, and the scene solved and
     // its light, cycle<N>.scene.txtpb and cycle<N>.csv, for `leaflux render`.
     std::set<int> plyCycles;
+    // Cycles whose picture the daemon draws (the scenario's `picture`): cycle<N>.png.
+    std::set<int> pngCycles;
     bool branchLight = false;  // ask for per-axis light only, not per leaf
     bool quiet = false;
 };

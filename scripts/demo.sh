@@ -37,7 +37,8 @@ stop_daemon() {
 
 start_daemon
 "$B/growth_stub/leaflux-grow" --scenario growth_stub/scenarios/wall-hole.txtpb --cycles 25 \
-    --endpoint "$endpoint" --out "$out" --ply-cycles 2,9,13,17,25 | tee "$out/grow.txt"
+    --endpoint "$endpoint" --out "$out" --ply-cycles 2,9,13,17,25 --png-cycles 2,9,13,17,25 \
+    | tee "$out/grow.txt"
 stop_daemon
 start_daemon
 "$B/growth_stub/leaflux-grow" --scenario growth_stub/scenarios/wall-hole.txtpb --cycles 25 \
@@ -53,16 +54,6 @@ start_daemon
     --policy proto/policies/above_10_leaves.txtpb --quiet | tee -a "$out/grow.txt"
 stop_daemon
 
-# The pictures, drawn by leaflux render from each cycle's scene and light, on one colour
-# scale: 0 to the most an organ gets on its two sides in any of them (rounded up).
-top=$(awk -F, 'FNR > 1 && $2 == "PAR" { if ($4 + $5 > m) m = $4 + $5 }
-               END { printf "%d", m + 1 }' "$out"/cycle{2,9,13,17,25}.csv)
-for c in 2 9 13 17 25; do
-    "$B/server/leaflux" render --scene "$out/cycle$c.scene.txtpb" --from "$out/cycle$c.csv" \
-        --camera "eye=-0.85,-0.9,0.75 look=0.6,0.05,0.5 fov=60" --side both --size 640x480 \
-        --range "0,$top" \
-        --out "$out/cycle$c.png" > /dev/null
-done
 /usr/bin/python3 examples/plot_growth.py "$out" "full light" "$out/direct_only" "direct light only"
 /usr/bin/python3 examples/compare_growth.py "$out" full "$out/direct_only" direct_only \
     "$out/growth_comparison"

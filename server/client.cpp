@@ -58,6 +58,11 @@ int Client::TimeoutMs(const v1::Request& request) const {
                 (it == organs_.end() ? 0 : it->second) + OrgansOf(request.cycle().delta().added());
             break;
         }
+        case v1::Request::kRender: {  // the session's ray engine built, then the picture
+            const auto it = organs_.find(request.render().session());
+            organs = it == organs_.end() ? 0 : it->second;
+            break;
+        }
         default:
             return timeouts_.statusMs;
     }
@@ -170,6 +175,12 @@ void Client::Close(const std::string& session) {
     request.mutable_close_session()->set_session(session);
     Expect(std::move(request), v1::Reply::kDone);
     organs_.erase(session);
+}
+
+v1::Picture Client::Render(const v1::RenderRequest& render) {
+    v1::Request request;
+    *request.mutable_render() = render;
+    return Expect(std::move(request), v1::Reply::kPicture).picture();
 }
 
 void Client::Shutdown() {

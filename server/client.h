@@ -33,7 +33,7 @@ class ClientError : public std::runtime_error {
 };
 
 // How long a client waits for a reply. Status, CloseSession and Shutdown wait `statusMs`;
-// OpenSession, Resync and Cycle, which validate or solve a scene, wait `sceneMs` plus
+// OpenSession, Resync, Cycle and Render, which validate, solve or draw a scene, wait `sceneMs` plus
 // `perOrganMs` for each organ the session's scene holds (as far as the client sent them).
 struct ClientTimeouts {
     int statusMs = 30'000;
@@ -66,6 +66,8 @@ class Client {
     v1::StatusReply Status(const std::string& session = "");
     void Resync(const v1::Resync& resync);
     void Close(const std::string& session);
+    // A picture of the session's light as its last cycle returned it.
+    v1::Picture Render(const v1::RenderRequest& render);
     void Shutdown();
 
     // A new connection to the same endpoint: replies to the old one are never read.

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "server/executor.h"
+#include "server/session_render.h"
 #include "solver/scene/light_units.h"
 #include "solver/util/error.h"
 
@@ -58,6 +59,8 @@ std::string Describe(const v1::Request& request) {
             return "close_session " + request.close_session().session();
         case v1::Request::kShutdown:
             return "shutdown";
+        case v1::Request::kRender:
+            return "render of session " + request.render().session();
         default:
             return "request without a known body";
     }
@@ -227,6 +230,10 @@ v1::CycleResult Session::Run(const v1::Cycle& cycle) {
     return result;
 }
 
+v1::Picture Session::Render(const v1::RenderRequest& request) const {
+    return RenderSession(store_.Get(), store_.Flat(), last_ ? &*last_ : nullptr, request);
+}
+
 SceneChange Session::Change(const v1::Cycle& cycle) const {
     const v1::TopologyDelta& delta = cycle.delta();
     SceneChange change;
@@ -378,6 +385,8 @@ std::string Daemon::KeyOf(const v1::Request& request) {
             return request.resync().session();
         case v1::Request::kCloseSession:
             return request.close_session().session();
+        case v1::Request::kRender:
+            return request.render().session();
         default:
             return "";
     }
@@ -416,6 +425,9 @@ v1::Reply Daemon::Handle(const v1::Request& request) {
             case v1::Request::kShutdown:
                 shutdown_ = true;
                 reply.mutable_done();
+                break;
+            case v1::Request::kRender:
+                reply = Draw(request.render());
                 break;
             default:
                 reply =
@@ -513,6 +525,13 @@ v1::Reply Daemon::RunCycle(const v1::Cycle& request) {
     *reply.mutable_cycle() = session->Run(request);
     reply.mutable_cycle()->set_session(request.session());
     reply.mutable_cycle()->set_number(request.number());
+    return reply;
+}
+
+v1::Reply Daemon::Draw(const v1::RenderRequest& request) {
+    const std::shared_ptr<Session> session = Find(request.session());
+    v1::Reply reply;
+    *reply.mutable_picture() = session->Render(request);
     return reply;
 }
 

@@ -72,6 +72,10 @@ class Session {
     int Nodes() const { return nodes_; }
     int Organs() const { return organs_; }
 
+    // A picture of the scene in the light the last cycle returned (RenderSession); changes
+    // nothing.
+    v1::Picture Render(const v1::RenderRequest& request) const;
+
   private:
     SceneChange Change(const v1::Cycle& cycle) const;
     v1::CycleResult Solve(const v1::OutputRequest& outputs) const;
@@ -115,6 +119,7 @@ class Daemon {
     v1::Reply Resynchronise(const v1::Resync& request);
     v1::Reply Status(const v1::StatusRequest& request);
     v1::Reply Close(const v1::CloseSession& request);
+    v1::Reply Draw(const v1::RenderRequest& request);
     std::shared_ptr<Session> Find(const std::string& id);
     // A session's solver settings, its threads within the daemon's limit; for the
     // instanced solver its run (policy by `species`) on the daemon's database.

@@ -3,12 +3,14 @@
 #include <google/protobuf/text_format.h>
 #include <spdlog/fmt/fmt.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <map>
 
 #include "server/cli_checks.h"
 #include "server/progress.h"
@@ -190,11 +192,45 @@ CLI::App* AddGenerateCommand(CLI::App& app, GenerateCommand& command) {
         "Write subtrees that are exact copies once, as shared structures placed by a frame and "
         "an id offset (Scene.structures, Scene.placements); leaflux solve reads the same scene "
         "as from the flat file");
+    generate->add_flag(
+        "--colour-bands", command.colourBands,
+        "Also bands B (400–500 nm), G (500–600) and R (600–700): the PAR sun, sky or lamps "
+        "split over them, green-leaf, bark and soil optics, for leaflux render --quantity colour");
     generate->add_flag("--quiet", command.quiet, "No progress bar");
     generate->add_option("--out", command.out, "Scene file to write (its folder is made)")
         ->required();
     return generate;
 }
+
+namespace {
+
+// Bands B, G and R beside PAR and NIR: each optics' (ρ, τ) in them, and the share of the
+// PAR source each takes. Leaves: a fresh green leaf's mean reflectance and transmittance
+// over each band (as PROSPECT gives them); bark and soil redder; walls and floor grey.
+// The sun's PAR splits as the clear-sky spectrum at the ground does, the sky's bluer, a
+// horticultural lamp's mostly red and blue.
+struct ColourBand {
+    Band band;
+    double sun, sky, lamp;
+};
+const ColourBand kColourBands[] = {{{"B", 400, 500}, 0.31, 0.40, 0.30},
+                                   {{"G", 500, 600}, 0.35, 0.33, 0.10},
+                                   {{"R", 600, 700}, 0.34, 0.27, 0.60}};
+const std::map<std::string, std::array<BandOptics, 3>> kColourOptics = {
+    {"leaf", {{{0.05, 0.05, 0.01, 0.01}, {0.15, 0.15, 0.10, 0.10}, {0.06, 0.06, 0.04, 0.04}}}},
+    {"stem", {{{0.06, 0.06, 0.0, 0.0}, {0.10, 0.10, 0.0, 0.0}, {0.16, 0.16, 0.0, 0.0}}}},
+    {"ground", {{{0.08, 0.08, 0.0, 0.0}, {0.11, 0.11, 0.0, 0.0}, {0.15, 0.15, 0.0, 0.0}}}},
+    {"wall", {{{0.80, 0.80, 0.0, 0.0}, {0.80, 0.80, 0.0, 0.0}, {0.80, 0.80, 0.0, 0.0}}}},
+    {"floor", {{{0.60, 0.60, 0.0, 0.0}, {0.60, 0.60, 0.0, 0.0}, {0.60, 0.60, 0.0, 0.0}}}}};
+
+// `values` (PAR, NIR) with the colour bands' shares of the PAR one appended.
+std::vector<double> WithColour(std::vector<double> values, double ColourBand::*share) {
+    const double par = values[0];
+    for (const ColourBand& c : kColourBands) values.push_back(par * c.*share);
+    return values;
+}
+
+}  // namespace
 
 // PAR- and NIR-like optics (leaf ρ, τ), a sun and a CIE overcast sky: a scene ready to solve.
 int RunGenerate(const GenerateCommand& command, std::uint64_t availableBytes) {
@@ -215,6 +251,18 @@ int RunGenerate(const GenerateCommand& command, std::uint64_t availableBytes) {
     scene.optics = {{"leaf", {{0.10, 0.10, 0.05, 0.05}, {0.45, 0.45, 0.45, 0.45}}},
                     {"stem", {{0.10, 0.10, 0.0, 0.0}, {0.40, 0.40, 0.0, 0.0}}},
                     {"ground", {{0.10, 0.10, 0.0, 0.0}, {0.30, 0.30, 0.0, 0.0}}}};
+    if (command.greenhouse) {
+        scene.optics.push_back({"wall", {{0.80, 0.80, 0.0, 0.0}, {0.85, 0.85, 0.0, 0.0}}});
+        scene.optics.push_back({"floor", {{0.60, 0.60, 0.0, 0.0}, {0.70, 0.70, 0.0, 0.0}}});
+    }
+    const auto bands = [&](std::vector<double> values, double ColourBand::*share) {
+        return command.colourBands ? WithColour(std::move(values), share) : values;
+    };
+    if (command.colourBands) {
+        for (const ColourBand& c : kColourBands) scene.bands.push_back(c.band);
+        for (Optics& optics : scene.optics)
+            for (const BandOptics& o : kColourOptics.at(optics.id)) optics.bands.push_back(o);
+    }
     PlantationParameters plantation;
     plantation.tree = command.tree;
     plantation.rows = command.rows;
@@ -232,11 +280,9 @@ int RunGenerate(const GenerateCommand& command, std::uint64_t availableBytes) {
         canopy.seed = command.tree.seed;
         AddRandomCanopy(scene, canopy);
     } else if (command.greenhouse) {
-        scene.optics.push_back({"wall", {{0.80, 0.80, 0.0, 0.0}, {0.85, 0.85, 0.0, 0.0}}});
-        scene.optics.push_back({"floor", {{0.60, 0.60, 0.0, 0.0}, {0.70, 0.70, 0.0, 0.0}}});
         GreenhouseParameters greenhouse;
         greenhouse.plantation = plantation;
-        greenhouse.lampExitanceWm2 = {command.lampPar, command.lampNir};
+        greenhouse.lampExitanceWm2 = bands({command.lampPar, command.lampNir}, &ColourBand::lamp);
         AddGreenhouse(scene, greenhouse);
     } else {
         AddPlantation(scene, plantation, command.noGround ? "" : "ground");
@@ -245,12 +291,12 @@ int RunGenerate(const GenerateCommand& command, std::uint64_t availableBytes) {
     if (!command.greenhouse) {
         scene.sources.suns.push_back(
             {{std::cos(h) * std::sin(a), std::cos(h) * std::cos(a), std::sin(h)},
-             {command.sunPar, command.sunNir},
+             bands({command.sunPar, command.sunNir}, &ColourBand::sun),
              0.0});
     }
     if (!command.noSky && !command.greenhouse) {
         scene.sources.skies.push_back({SkyModel::kCieOvercast,
-                                       {command.skyPar, command.skyNir},
+                                       bands({command.skyPar, command.skyNir}, &ColourBand::sky),
                                        SkyDiscretizationNamed(command.skyCones)});
     }
     scene.Validate();

@@ -24,7 +24,7 @@ struct GenerateCommand {
     double lampPar = 1500.0, lampNir = 150.0;
     std::string skyCones = "continuous";
     int prototypes = 4;
-    bool instanced = false, quiet = false;
+    bool instanced = false, quiet = false, colourBands = false;
     std::string out;
 };
 

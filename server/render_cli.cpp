@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <iostream>
+#include <sstream>
 
 #include "server/cli_checks.h"
 #include "server/scene_proto.h"
@@ -47,23 +48,35 @@ RenderSettings SettingsOf(const RenderCommand& command, const Scene& scene) {
     settings.samples = command.pixelSamples;
     settings.quantity = command.quantity == "absorbed"    ? Quantity::kAbsorbed
                         : command.quantity == "radiosity" ? Quantity::kRadiosity
+                        : command.quantity == "colour"    ? Quantity::kTrueColour
                                                           : Quantity::kIrradiance;
     settings.side = command.side == "upper"   ? Side::kUpperSide
                     : command.side == "lower" ? Side::kLowerSide
                     : command.side == "both"  ? Side::kBothSides
                                               : Side::kSeenSide;
-    settings.band = 0;
-    if (!command.band.empty()) {
-        settings.band = -1;
-        for (std::size_t b = 0; b < scene.bands.size(); ++b)
-            if (scene.bands[b].name == command.band) settings.band = static_cast<int>(b);
-        if (settings.band < 0)
-            throw InputError(ErrorCode::kNotFound, "--band",
-                             "the scene has no band " + command.band);
+    const auto bandIndex = [&](const std::string& name, const std::string& option) {
+        const int b = scene.BandIndex(name);
+        if (b < 0) throw InputError(ErrorCode::kNotFound, option, "the scene has no band " + name);
+        return b;
+    };
+    settings.band = command.band.empty() ? 0 : bandIndex(command.band, "--band");
+    if (settings.quantity == Quantity::kTrueColour) {
+        std::stringstream names(command.rgb);
+        std::string name;
+        int k = 0;
+        while (std::getline(names, name, ',')) {
+            if (k == 3) break;
+            settings.rgb[k++] = bandIndex(name, "--rgb");
+        }
+        if (k != 3 || std::getline(names, name))
+            throw InputError(ErrorCode::kParse, "--rgb",
+                             "expects three band names, such as R,G,B, got '" + command.rgb + "'");
     }
     settings.photons = command.photons;
     if (!command.range.empty()) settings.range = ParseRange(command.range);
     settings.palette = command.palette == "grey" ? Palette::kGrey : Palette::kViridis;
+    settings.scaleBar = command.scaleBar;
+    settings.northArrow = command.northArrow;
     settings.threads = command.solve.threads;
     Validate(settings, scene);
     return settings;
@@ -91,15 +104,18 @@ CLI::App* AddRenderCommand(CLI::App& app, RenderCommand& command) {
         "nothing solved (organs it lacks drawn grey)");
     render
         ->add_option("--quantity", command.quantity,
-                     "irradiance (arriving), absorbed (absorbed power per area of the organ) or "
-                     "radiosity (leaving: ρ E + τ E from the other side)")
-        ->check(CLI::IsMember({"irradiance", "absorbed", "radiosity"}));
+                     "irradiance (arriving), absorbed (absorbed power per area of the organ), "
+                     "radiosity (leaving: ρ E + τ E from the other side) or colour (the "
+                     "radiosity of the --rgb bands as red, green and blue, linear on one scale)")
+        ->check(CLI::IsMember({"irradiance", "absorbed", "radiosity", "colour"}));
     render
         ->add_option("--side", command.side,
                      "irradiance, radiosity: seen (the side facing the camera), upper, lower or "
                      "both (summed)")
         ->check(CLI::IsMember({"seen", "upper", "lower", "both"}));
     render->add_option("--band", command.band, "Band by name (default: the scene's first)");
+    render->add_option("--rgb", command.rgb,
+                       "colour: the three bands shown red, green and blue, by name");
     render->add_flag(
         "--photons", command.photons,
         "In µmol m⁻² s⁻¹ (the band's photon factor, 4.57 µmol/J for PAR) instead of W/m²");
@@ -110,6 +126,10 @@ CLI::App* AddRenderCommand(CLI::App& app, RenderCommand& command) {
         ->add_option("--palette", command.palette,
                      "viridis, or grey (black to white, linear: pixel ratios are value ratios)")
         ->check(CLI::IsMember({"viridis", "grey"}));
+    render->add_flag("--scale-bar", command.scaleBar,
+                     "A round length at the view's bottom-left, true at the look point's distance");
+    render->add_flag("--north-arrow", command.northArrow,
+                     "An arrow towards north (+y) at the look point, top right");
     render->add_flag("--open-in-view", command.openInView,
                      "instanced: open only the instances whose boxes are in view (Soler 2003 "
                      "§7.1); the others are solved whole, from their phase functions");

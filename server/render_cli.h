@@ -12,9 +12,9 @@ namespace leaflux {
 struct RenderCommand {
     SolveCommand solve;
     std::string camera, size = "1024x768", out, from, quantity = "irradiance", side = "seen", band,
-                        range, palette = "viridis";
+                        range, palette = "viridis", rgb = "R,G,B";
     int pixelSamples = 4;
-    bool photons = false, openInView = false;
+    bool photons = false, openInView = false, scaleBar = false, northArrow = false;
 };
 
 CLI::App* AddRenderCommand(CLI::App& app, RenderCommand& command);

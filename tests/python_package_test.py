@@ -422,6 +422,35 @@ def test_typed_errors():
         assert client.status(session).sessions[0].cycles == 1
 
 
+def test_render_draws_the_last_cycles_light():
+    """The daemon's picture of a session: the top leaf, seen from above on the linear grey
+    scale, has the grey of the irradiance the cycle returned; bad settings are refused."""
+    import io
+    import matplotlib.image
+    from leaflux import Client, NotFound
+    with daemon() as d, Client(d.endpoint, timeout_s=30) as client:
+        session = client.open(scene(1), hrc())
+        light = client.cycle(session, 1)
+        irradiance = light.organ(10).band("PAR").irradiance_upper_wm2
+        picture = client.render(session, eye=(0.05, 0.05, 3), look=(0.05, 0.05, 1), up=(0, 1, 0),
+                                fov_deg=2, size=(64, 48), palette="grey", value_range=(0, 800))
+        assert picture.caption == "PAR irradiance, side facing the camera (W/m²)", picture.caption
+        image = matplotlib.image.imread(io.BytesIO(picture.png), format="png")
+        assert image.shape[1] == 64 and image.shape[0] > 48, image.shape
+        assert abs(image[24, 32, 0] * 255 - round(255 * irradiance / 800)) < 0.5, image[24, 32]
+        for bad in ({"quantity": "heat"}, {"side": "left"}):
+            try:
+                client.render(session, eye=(0, 0, 3), look=(0, 0, 1), **bad)
+                raise AssertionError(f"{bad} was drawn")
+            except ValueError as e:
+                assert next(iter(bad)) in str(e), e
+        try:
+            client.render(session, eye=(0, 0, 3), look=(0, 0, 1), band="NIR")
+            raise AssertionError("a band the scene lacks was drawn")
+        except NotFound as e:
+            assert e.field == "render.band", e
+
+
 def test_resync_after_a_restart():
     from leaflux import Client, LocalDaemon, pb
     port = free_port()

@@ -1,7 +1,8 @@
 // leaflux render: pictures that show what was solved. A plate under a known irradiance
 // takes the colour bar's colour at that value; a plate with half the irradiance is half as
-// bright on the linear grey scale; a bad camera is refused naming its field; a solution
-// read back from its CSV draws the same picture.
+// bright on the linear grey scale; true colour shows three bands' radiosities; the scale
+// bar measures a plate; the north arrow points north; a bad camera is refused naming its
+// field; a solution read back from its CSV draws the same picture.
 #include "solver/render/render.h"
 
 #include <gtest/gtest.h>
@@ -242,6 +243,78 @@ TEST(Render, ACsvThatDoesNotMatchTheSceneIsRefusedNamingItsLine) {
     EXPECT_EQ(refusal(header + "plate0,PAR,1,abc,0,100\n"),
               path + ":2 irradiance_upper_wm2: not a number: 'abc'");
     EXPECT_EQ(refusal("organ,band\nplate0,PAR\n"), path + ":1: no column irradiance_upper_wm2");
+}
+
+// True colour: a white-lit plate of ρ = 0.8, 0.4, 0.2 in bands R, G, B sends ρ E in each;
+// on one linear scale up to the largest, its pixel is (255, 255 / 2, 255 / 4).
+TEST(Render, TrueColourShowsEachBandsRadiosityOnOneLinearScale) {
+    Scene scene;
+    scene.bands = {{"R"}, {"G"}, {"B"}};
+    scene.optics.push_back({"paint", {Opaque(0.8), Opaque(0.4), Opaque(0.2)}});
+    scene.nodes.push_back(OrganNode(1, "plate", Rectangle(1.0, 1.0, 1.0), "paint"));
+    Sun sun = SunAt(90.0, 0.0, 100.0);
+    sun.normalIrradianceWm2 = {100.0, 100.0, 100.0};
+    scene.sources.suns.push_back(sun);
+    scene.Validate();
+    const PreparedScene prepared(scene);
+    const Solution solution = SolveHrc(prepared);
+    RenderSettings settings;
+    settings.camera = Above(0.0);
+    settings.width = 64, settings.height = 48;
+    settings.quantity = Quantity::kTrueColour;
+    settings.rgb = {0, 1, 2};
+    const Rendering picture = Render(scene, prepared.Rays(), solution, settings);
+    EXPECT_NEAR(picture.scale.max, 80.0, 1e-6 * 80.0);
+    EXPECT_EQ(picture.image.At(32, 24), (Rgb{255, 128, 64}));
+    EXPECT_EQ(picture.scale.palette, Palette::kGrey);  // the bar: one channel's scale
+    settings.rgb = {2, 1, 0};                          // the bands swapped: the colour too
+    EXPECT_EQ(Render(scene, prepared.Rays(), solution, settings).image.At(32, 24),
+              (Rgb{64, 128, 255}));
+    settings.rgb = {0, 1, 3};
+    EXPECT_THROW(Render(scene, prepared.Rays(), solution, settings), InputError);
+}
+
+// The scale bar is as long as its length measured on a plate at the look point's distance:
+// a 1 m plate facing the camera spans the bar's pixels per metre.
+TEST(Render, TheScaleBarMeasuresThePlateAtTheLookPoint) {
+    const Scene scene = Plates({0.0}, 100.0);
+    const PreparedScene prepared(scene);
+    const Solution solution = SolveHrc(prepared);
+    RenderSettings settings;
+    settings.camera = {{0.0, 0.0, 11.0}, {0.0, 0.0, 1.0}, {0.0, 1.0, 0.0}, 20.0};
+    settings.width = 400, settings.height = 300;
+    settings.samples = 1;
+    settings.palette = Palette::kGrey;
+    settings.scaleBar = true;
+    const Rendering picture = Render(scene, prepared.Rays(), solution, settings);
+    int plate = 0;  // the lit plate's pixels along the view's middle row
+    for (int x = 0; x < settings.width; ++x)
+        plate += picture.image.At(x, 150) == Rgb{255, 255, 255};
+    // 10 m away in a 20° view: 300 px span 2·10·tan 10° = 3.53 m, a fifth of the width
+    // 0.94 m: the bar is 0.5 m.
+    EXPECT_EQ(picture.scaleBar.metres, 0.5);
+    EXPECT_NEAR(picture.scaleBar.pixels, 0.5 * plate, 1.0);
+    // The bar drawn in ink at the bottom-left, its length from its first column.
+    const int row = settings.height - 14, left = 12;
+    int drawn = 0;
+    while (picture.image.At(left + drawn, row) == Rgb{20, 20, 20}) ++drawn;
+    EXPECT_EQ(drawn, picture.scaleBar.pixels);
+}
+
+// North (+y) in the picture: up for a camera looking down with north up, left with east up
+// or looking east, none looking due north.
+TEST(Render, TheNorthArrowPointsNorthAtTheLookPoint) {
+    const auto north = [](const Camera& camera) {
+        return NorthInPicture(camera, View(camera, 200, 100));
+    };
+    const auto near = [](std::optional<glm::dvec2> v, glm::dvec2 expected) {
+        return v && glm::length(*v - expected) < 1e-9;
+    };
+    EXPECT_TRUE(near(north(Above(0.0)), {0.0, -1.0}));
+    EXPECT_TRUE(near(north({{0, 0, 10}, {0, 0, 0}, {1, 0, 0}, 45.0}), {-1.0, 0.0}));
+    EXPECT_TRUE(near(north({{-10, 0, 0}, {0, 0, 0}, {0, 0, 1}, 45.0}), {-1.0, 0.0}));
+    EXPECT_TRUE(near(north({{0, 0, 10}, {0, 0, 0}, {0, -1, 0}, 45.0}), {0.0, 1.0}));
+    EXPECT_FALSE(north({{0, -10, 0}, {0, 0, 0}, {0, 0, 1}, 45.0}));
 }
 
 TEST(Render, TicksAreRoundValuesWithinTheScale) {

@@ -13,7 +13,7 @@ import logging
 import os
 import time
 from dataclasses import dataclass
-from typing import Callable, Dict, Iterable, Optional, Tuple
+from typing import Callable, Dict, Iterable, Optional, Sequence, Tuple
 
 import zmq
 
@@ -46,6 +46,14 @@ class Timeouts:
 
 def _organs(nodes: Iterable["pb.Node"]) -> int:
     return sum(1 for n in nodes if n.HasField("organ"))
+
+
+def _enum(enum: "object", prefix: str, name: str, parameter: str) -> int:
+    """The value of `prefix` + `name` in a protobuf enum; ValueError naming `parameter`."""
+    labels = [n[len(prefix):].lower() for n in enum.keys()]  # type: ignore[attr-defined]
+    if name.lower() not in labels:
+        raise ValueError(f"{parameter}: {name!r} is not one of {', '.join(labels)}")
+    return int(enum.Value(prefix + name.upper()))  # type: ignore[attr-defined]
 
 
 def _curve_key(key: str) -> bytes:
@@ -121,6 +129,8 @@ class Client:
         elif kind == "cycle":
             organs = (self._organs.get(request.cycle.session, 0)
                       + _organs(request.cycle.delta.added))
+        elif kind == "render":  # the session's ray engine built, then the picture
+            organs = self._organs.get(request.render.session, 0)
         else:
             return self.timeouts.status_s
         return self.timeouts.scene_s + self.timeouts.per_organ_s * organs
@@ -242,6 +252,40 @@ class Client:
         scene, settings = resync()
         self.resync(session, scene, settings, last_cycle=number - 1)
         return CycleLight.from_proto(self.call(request).cycle)
+
+    def render(self, session: str, eye: Sequence[float], look: Sequence[float],
+               up: Sequence[float] = (0.0, 0.0, 1.0), fov_deg: float = 45.0,
+               size: Tuple[int, int] = (1024, 768), quantity: str = "irradiance",
+               side: str = "seen", band: str = "", rgb: Sequence[str] = (),
+               value_range: Optional[Tuple[float, float]] = None, palette: str = "viridis",
+               pixel_samples: int = 4, photons: bool = False, scale_bar: bool = False,
+               north_arrow: bool = False) -> "pb.Picture":
+        """A picture of `session`'s scene in the light its last cycle returned (that cycle
+        must have asked for leaves), drawn by the daemon as `leaflux render` draws it.
+
+        `quantity`: irradiance, absorbed, radiosity or true_colour (the `rgb` bands, default
+        R, G, B); `side`: seen, upper, lower or both; `value_range`: (min, max) of the
+        colour scale (default 0 to the largest value in view); `palette`: viridis or grey.
+        The reply's `png` holds the PNG file's bytes, `caption`, `scale_min`, `scale_max`
+        what the colour bar shows."""
+        request = pb.Request()
+        r = request.render
+        r.session = session
+        for field, point in (("eye", eye), ("look", look), ("up", up)):
+            getattr(r.camera, field).CopyFrom(pb.Vec3(x=point[0], y=point[1], z=point[2]))
+        r.camera.fov_deg = fov_deg
+        r.width, r.height = size
+        r.pixel_samples = pixel_samples
+        r.quantity = _enum(pb.RenderQuantity, "RENDER_QUANTITY_", quantity, "quantity")
+        r.side = _enum(pb.RenderSide, "RENDER_SIDE_", side, "side")
+        r.band = band
+        r.rgb.extend(rgb)
+        r.photons = photons
+        if value_range is not None:
+            r.range.min, r.range.max = value_range
+        r.palette = _enum(pb.RenderPalette, "RENDER_PALETTE_", palette, "palette")
+        r.scale_bar, r.north_arrow = scale_bar, north_arrow
+        return self.call(request).picture
 
     def status(self, session: str = "") -> "pb.StatusReply":
         """The daemon's counts and limits (`session_count`, `max_message_bytes`, …), or one

@@ -133,6 +133,16 @@ bool View::MaySee(const glm::dvec3& boxMin, const glm::dvec3& boxMax) const {
     return std::none_of(std::begin(outside), std::end(outside), [](int n) { return n == 8; });
 }
 
+std::optional<glm::dvec2> View::Project(const glm::dvec3& point) const {
+    const glm::dvec3 d = point - eye_;
+    const double z = glm::dot(d, forward_);
+    if (!(z > 0.0)) return std::nullopt;
+    // Direction(x, y) ∝ forward + (x − w/2) right_ + (y − h/2) down_, right_ ⊥ down_.
+    const double r2 = glm::dot(right_, right_), d2 = glm::dot(down_, down_);
+    return glm::dvec2(halfWidth_ + glm::dot(d, right_) / (z * r2),
+                      halfHeight_ + glm::dot(d, down_) / (z * d2));
+}
+
 glm::dvec3 View::Direction(double x, double y) const {
     return glm::normalize(forward_ + (x - halfWidth_) * right_ + (y - halfHeight_) * down_);
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <glm/glm.hpp>
+#include <optional>
 #include <string>
 
 namespace leaflux {
@@ -31,6 +32,12 @@ class View {
     // (pixel (i, j) covers [i, i + 1) × [j, j + 1)).
     glm::dvec3 Direction(double x, double y) const;
     const glm::dvec3& Eye() const { return eye_; }
+    // Where the world point lands in the picture, in pixels from its top-left corner;
+    // nothing for a point on or behind the eye's plane.
+    std::optional<glm::dvec2> Project(const glm::dvec3& point) const;
+    // Pixels a metre spans at `distance` from the eye along the view (perspective: a length
+    // in a plane facing the camera).
+    double PixelsPerMetre(double distance) const { return 1.0 / (glm::length(right_) * distance); }
     // Whether a world box may be in view: false only when all its corners lie behind the
     // eye or beyond one side of the picture (conservative: a box near a corner of the view
     // may be kept though unseen).

@@ -2,6 +2,8 @@
 
 #include <png.h>
 
+#include <stdexcept>
+
 #include "solver/util/error.h"
 
 namespace leaflux {
@@ -27,6 +29,28 @@ void WritePng(const Image& image, const std::string& path) {
     const std::string message = png.message;
     png_image_free(&png);
     if (!written) throw InputError(ErrorCode::kIo, path, "cannot write the PNG: " + message);
+}
+
+std::string EncodePng(const Image& image) {
+    png_image png{};
+    png.version = PNG_IMAGE_VERSION;
+    png.width = static_cast<png_uint_32>(image.Width());
+    png.height = static_cast<png_uint_32>(image.Height());
+    png.format = PNG_FORMAT_RGB;
+    // First the size (a null buffer), then the bytes.
+    png_alloc_size_t bytes = 0;
+    std::string out;
+    bool written = png_image_write_to_memory(&png, nullptr, &bytes, 0, &image.At(0, 0), 0, nullptr);
+    if (written) {
+        out.resize(bytes);
+        written =
+            png_image_write_to_memory(&png, out.data(), &bytes, 0, &image.At(0, 0), 0, nullptr);
+        out.resize(bytes);
+    }
+    const std::string message = png.message;
+    png_image_free(&png);
+    if (!written) throw std::runtime_error("cannot encode the PNG: " + message);
+    return out;
 }
 
 Image ReadPng(const std::string& path) {

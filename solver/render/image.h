@@ -34,6 +34,8 @@ class Image {
 
 // Writes `image` as a PNG file; an InputError (kIo) naming the path when it cannot.
 void WritePng(const Image& image, const std::string& path);
+// The PNG file's bytes, for a picture sent rather than written.
+std::string EncodePng(const Image& image);
 // Reads a PNG file written by WritePng (or any PNG, converted to 8-bit RGB).
 Image ReadPng(const std::string& path);
 

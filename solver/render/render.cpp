@@ -20,11 +20,13 @@ constexpr Rgb kSky{232, 236, 240};       // where a ray leaves the scene
 constexpr Rgb kLamp{255, 244, 214};      // an emitter's own surface
 constexpr Rgb kUnsolved{150, 150, 150};  // an organ of a structure solved whole
 
-// What one ray saw.
+// What one ray saw: a receiver and its side; the value is read from the solution once the
+// scale is made.
 struct Sample {
     enum Kind : std::uint8_t { kMiss, kSurface, kLampSurface, kUnsolvedSurface };
+    std::uint32_t receiver = 0;
     Kind kind = kMiss;
-    float value = 0.0f;
+    bool upper = false;  // the side seen
 };
 
 // The quantity on one side of a receiver (upper: true), in W/m².
@@ -37,36 +39,51 @@ double SideValue(const BandLight& light, const BandOptics* optics, bool upper, Q
                  : optics->rhoLower * own + optics->tauUpperToLower * other;
 }
 
+// The quantity of band `band` on `receiver`, W/m² (true colour: its radiosity).
 double ValueOf(const Scene& scene, const Receiver& receiver, const BandLight& light,
-               const RenderSettings& settings, bool upperSeen) {
+               const RenderSettings& settings, int band, bool upperSeen) {
     if (settings.quantity == Quantity::kAbsorbed)
         return receiver.areaM2 > 0.0 ? light.absorbedW / receiver.areaM2 : 0.0;
+    const Quantity quantity =
+        settings.quantity == Quantity::kTrueColour ? Quantity::kRadiosity : settings.quantity;
     const BandOptics* optics =
-        receiver.optics >= 0 ? &scene.optics[receiver.optics].bands[settings.band] : nullptr;
+        receiver.optics >= 0 ? &scene.optics[receiver.optics].bands[band] : nullptr;
     switch (settings.side) {
         case Side::kSeenSide:
-            return SideValue(light, optics, upperSeen, settings.quantity);
+            return SideValue(light, optics, upperSeen, quantity);
         case Side::kUpperSide:
-            return SideValue(light, optics, true, settings.quantity);
+            return SideValue(light, optics, true, quantity);
         case Side::kLowerSide:
-            return SideValue(light, optics, false, settings.quantity);
+            return SideValue(light, optics, false, quantity);
         case Side::kBothSides:
             // A wall or a ground bounds two spaces: summing its sides would paint a wall's
             // sunlit outside onto its inside. It shows the side in view.
             if (receiver.kind == ReceiverKind::kEnvironment)
-                return SideValue(light, optics, upperSeen, settings.quantity);
-            return SideValue(light, optics, true, settings.quantity) +
-                   SideValue(light, optics, false, settings.quantity);
+                return SideValue(light, optics, upperSeen, quantity);
+            return SideValue(light, optics, true, quantity) +
+                   SideValue(light, optics, false, quantity);
     }
     return 0.0;
 }
 
+// The bands a picture shows: the one asked, or the three of true colour.
+std::vector<int> BandsShown(const RenderSettings& settings) {
+    if (settings.quantity == Quantity::kTrueColour)
+        return {settings.rgb[0], settings.rgb[1], settings.rgb[2]};
+    return {settings.band};
+}
+
 std::string CaptionOf(const Scene& scene, const RenderSettings& settings) {
-    const char* what[] = {"irradiance", "absorbed per area", "radiosity"};
+    const char* what[] = {"irradiance", "absorbed per area", "radiosity", "radiosity"};
     const char* side[] = {", side facing the camera", ", upper side", ", lower side",
                           ", both sides summed"};
-    std::string caption =
-        scene.bands[settings.band].name + " " + what[static_cast<int>(settings.quantity)];
+    std::string bands = scene.bands[settings.band].name;
+    if (settings.quantity == Quantity::kTrueColour) {
+        const auto& b = scene.bands;
+        bands = b[settings.rgb[0]].name + ", " + b[settings.rgb[1]].name + ", " +
+                b[settings.rgb[2]].name + " as red, green, blue:";
+    }
+    std::string caption = bands + " " + what[static_cast<int>(settings.quantity)];
     if (settings.quantity != Quantity::kAbsorbed) caption += side[static_cast<int>(settings.side)];
     return caption + (settings.photons ? " (µmol m⁻² s⁻¹)" : " (W/m²)");
 }
@@ -95,12 +112,17 @@ void Validate(const RenderSettings& settings, const Scene& scene) {
                              " rays, over the " + std::to_string(kMaxRays) +
                              " a picture may take; fewer pixels or samples");
     }
-    if (settings.band < 0 || settings.band >= static_cast<int>(scene.bands.size()))
+    const int bands = static_cast<int>(scene.bands.size());
+    if (settings.band < 0 || settings.band >= bands)
         throw InputError(ErrorCode::kNotFound, "band", "not a band of the scene");
-    if (settings.photons && !PhotonUmolPerJ(scene.bands[settings.band])) {
-        throw InputError(ErrorCode::kInvalidArgument, "photons",
-                         "band " + scene.bands[settings.band].name + " has no photon factor");
-    }
+    for (int b : settings.rgb)
+        if (b < 0 || b >= bands)
+            throw InputError(ErrorCode::kNotFound, "rgb", "not a band of the scene");
+    for (int b : BandsShown(settings))
+        if (settings.photons && !PhotonUmolPerJ(scene.bands[b])) {
+            throw InputError(ErrorCode::kInvalidArgument, "photons",
+                             "band " + scene.bands[b].name + " has no photon factor");
+        }
     if (settings.range) {
         const auto [low, high] = *settings.range;
         if (!std::isfinite(low) || !std::isfinite(high) || !(low < high))
@@ -118,7 +140,18 @@ Rendering Render(const Scene& scene, const RayScene& rays, const Solution& solut
     const int grid = std::max(1, static_cast<int>(std::lround(std::sqrt(settings.samples))));
     const int perPixel = grid * grid;
     const View view(settings.camera, w, h);
-    const double unit = settings.photons ? *PhotonUmolPerJ(scene.bands[settings.band]) : 1.0;
+    const std::vector<int> bands = BandsShown(settings);
+    std::vector<double> units;  // per band shown: W/m² to the picture's unit
+    for (int b : bands) units.push_back(settings.photons ? *PhotonUmolPerJ(scene.bands[b]) : 1.0);
+    // A sample's value in each band shown (true colour: red, green, blue).
+    const auto values = [&](const Sample& s) {
+        std::array<double, 3> v{0.0, 0.0, 0.0};
+        for (std::size_t k = 0; k < bands.size(); ++k)
+            v[k] = units[k] * ValueOf(scene, flat.receivers[s.receiver],
+                                      solution.light[s.receiver][bands[k]], settings, bands[k],
+                                      s.upper);
+        return v;
+    };
     const RayStart eye{flat.ToLocal(settings.camera.eye)};
 
     // First every ray's value, so that the scale can come from what is in view.
@@ -135,19 +168,13 @@ Rendering Render(const Scene& scene, const RayScene& rays, const Solution& solut
                         Sample& s = samples[(static_cast<std::size_t>(y) * w + x) * perPixel + k];
                         if (hit.fate != RayFate::kHit) continue;
                         const Triangle& triangle = flat.triangles[hit.triangle];
-                        const std::uint32_t r = triangle.receiver;
-                        const Receiver& receiver = flat.receivers[r];
-                        if (receiver.kind == ReceiverKind::kEmitter) {
-                            s.kind = Sample::kLampSurface;
-                        } else if (!solution.unsolved.empty() && solution.unsolved[r]) {
-                            s.kind = Sample::kUnsolvedSurface;
-                        } else {
-                            s.kind = Sample::kSurface;
-                            const bool upper = glm::dot(triangle.normal, d) < 0.0;
-                            s.value = static_cast<float>(
-                                unit * ValueOf(scene, receiver, solution.light[r][settings.band],
-                                               settings, upper));
-                        }
+                        s.receiver = triangle.receiver;
+                        s.upper = glm::dot(triangle.normal, d) < 0.0;
+                        s.kind = flat.receivers[s.receiver].kind == ReceiverKind::kEmitter
+                                     ? Sample::kLampSurface
+                                 : !solution.unsolved.empty() && solution.unsolved[s.receiver]
+                                     ? Sample::kUnsolvedSurface
+                                     : Sample::kSurface;
                     }
         });
     };
@@ -158,14 +185,16 @@ Rendering Render(const Scene& scene, const RayScene& rays, const Solution& solut
     }
 
     Rendering rendering;
-    rendering.scale.palette = settings.palette;
+    const bool colour = settings.quantity == Quantity::kTrueColour;
+    rendering.scale.palette = colour ? Palette::kGrey : settings.palette;
     if (settings.range) {
         std::tie(rendering.scale.min, rendering.scale.max) = *settings.range;
     } else {
         double largest = 0.0;
         for (const Sample& s : samples)
-            if (s.kind == Sample::kSurface && std::isfinite(s.value))
-                largest = std::max(largest, static_cast<double>(s.value));
+            if (s.kind == Sample::kSurface)
+                for (double v : values(s))
+                    if (std::isfinite(v)) largest = std::max(largest, v);
         rendering.scale.min = 0.0;
         rendering.scale.max = largest > 0.0 ? largest : 1.0;
     }
@@ -180,9 +209,15 @@ Rendering Render(const Scene& scene, const RayScene& rays, const Solution& solut
                 if (s.kind == Sample::kLampSurface) c = kLamp;
                 if (s.kind == Sample::kUnsolvedSurface) c = kUnsolved;
                 if (s.kind == Sample::kSurface) {
-                    c = rendering.scale.Of(s.value, x, y);
+                    const std::array<double, 3> v = values(s);
+                    // True colour: each channel on the grey scale (a channel beyond it striped).
+                    c = colour ? Rgb{rendering.scale.Of(v[0], x, y).r,
+                                     rendering.scale.Of(v[1], x, y).g,
+                                     rendering.scale.Of(v[2], x, y).b}
+                               : rendering.scale.Of(v[0], x, y);
                     ++surface;
-                    beyond += rendering.scale.Beyond(s.value);
+                    beyond += std::any_of(v.begin(), v.begin() + static_cast<long>(bands.size()),
+                                          [&](double u) { return rendering.scale.Beyond(u); });
                 }
                 r += c.r, g += c.g, b += c.b;
             }
@@ -191,6 +226,15 @@ Rendering Render(const Scene& scene, const RayScene& rays, const Solution& solut
             };
             viewImage.At(x, y) = {mean(r), mean(g), mean(b)};
         }
+    if (settings.scaleBar) {
+        rendering.scaleBar = ScaleBarOf(settings.camera, view, w);
+        DrawScaleBar(viewImage, rendering.scaleBar);
+    }
+    if (settings.northArrow) {
+        const bool ahead =
+            glm::dot(settings.camera.look - settings.camera.eye, {0.0, 1.0, 0.0}) > 0.0;
+        DrawNorthArrow(viewImage, NorthInPicture(settings.camera, view), ahead);
+    }
     rendering.caption = CaptionOf(scene, settings);
     const Legend legend = DrawLegend(viewImage, rendering.scale, rendering.caption, beyond > 0);
     rendering.image = legend.image;
