@@ -559,8 +559,12 @@ void SceneSolve::Outputs(Solution& solution) {
         traversal_.Subtrees().empty() ? 0 : traversal_.Depth(hierarchy_, *active_));
     if (channels_.beams > 1) return;  // their light is read by Patches
     SolutionSink sink(solution);
+    // The scene's top level holding closed instances: what passes them, and what they send,
+    // escapes by their transmittance (a local problem's escape is not the scene's).
+    const bool top = !hierarchy_.Closed().empty() && !occlusion_.HasOutside();
     rayCount_ += WriteOutputs(model_, rays_, traversal_.Leaves(), optics_, field_, leafLight_, sink,
-                              solution.balance);
+                              solution.balance, top ? &occlusion_ : nullptr);
+    if (top) rayCount_ += AddClosedEscape(model_, occlusion_, field_, solution.balance);
 }
 
 void SceneSolve::Arrived(LevelSolution& level) const {

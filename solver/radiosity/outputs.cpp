@@ -14,7 +14,7 @@ namespace leaflux {
 std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
                           const std::vector<std::uint32_t>& allLeaves, const ReceiverOptics& optics,
                           const Field& field, const LeafLight& leafLight, LightSink& sink,
-                          std::vector<EnergyBalance>& balances) {
+                          std::vector<EnergyBalance>& balances, const Occlusion* occlusion) {
     const Hierarchy& hierarchy = model.Nodes();
     // Surfaces held from outside a local problem have no output and are not in its balance.
     std::vector<std::uint32_t> leaves;
@@ -56,17 +56,24 @@ std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
                 mean > 0.0
                     ? static_cast<int>(std::clamp(std::lround(2.0 * sent[i][s] / mean), 2L, 64L))
                     : 2;
-            int out = 0;
+            double out = 0.0, squares = 0.0;
             for (int k = 0; k < count; ++k) {
                 const Hierarchy::Point p =
                     hierarchy.Sample(leaves[i], random.Uniform(), random.Uniform());
                 const glm::dvec3 n = s == kUpper ? node.normal : -node.normal;
                 const glm::dvec3 omega =
                     CosineHemisphere(n, (k + random.Uniform()) / count, random.Uniform());
-                out += rays.Trace({p.position, p.triangle}, omega).fate != RayFate::kHit;
+                const RayStart start{p.position, p.triangle};
+                const double passed =
+                    occlusion ? occlusion->Transmittance(start, omega)
+                              : static_cast<double>(rays.Trace(start, omega).fate != RayFate::kHit);
+                out += passed, squares += passed * passed;
             }
-            escape[i][s] = static_cast<double>(out) / count;
-            doubt[i][s] = escape[i][s] * (1.0 - escape[i][s]) / (count - 1.0);
+            // The mean's variance from the rays' own spread (for rays that pass or not,
+            // f (1 − f) / (count − 1)).
+            escape[i][s] = out / count;
+            doubt[i][s] =
+                std::max(0.0, squares / count - escape[i][s] * escape[i][s]) / (count - 1.0);
             traces[i] += count;
         }
     });
@@ -128,6 +135,66 @@ std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
     // The links' own error is not in it: this is the escape estimate's noise alone.
     for (int k = 0; k < bands; ++k) balances[k].stderrW = std::sqrt(variance[k]);
     return traced;
+}
+
+std::int64_t AddClosedEscape(const NodeModel& model, const Occlusion& occlusion, const Field& field,
+                             std::vector<EnergyBalance>& balances) {
+    const Hierarchy& hierarchy = model.Nodes();
+    const DirectionSet& directions = model.Directions();
+    const Channels& channels = model.ChannelSet();
+    const int bins = model.BinCount(), count = channels.Count();
+    const std::size_t closed = hierarchy.Closed().size();
+    constexpr int kRaysPerBin = 8;
+    // Per closed instance and channel: escaped W and the variance of that estimate.
+    std::vector<std::vector<double>> escaped(closed, std::vector<double>(count, 0.0)),
+        variance(closed, std::vector<double>(count, 0.0));
+    std::vector<std::int64_t> traced(closed, 0);
+    tbb::parallel_for(std::size_t{0}, closed, [&](std::size_t c) {
+        SetFlushToZero();
+        const ClosedNode& node = hierarchy.Closed()[c];
+        const double* sent =
+            field.intensity[model.Slot(hierarchy.NodeOfClosed(static_cast<std::int32_t>(c)))];
+        const std::uint32_t self = static_cast<std::uint32_t>(c);
+        Random random(StreamSeed(0xE5CC, c));
+        for (int o = 0; o < bins; ++o) {
+            if (std::all_of(sent + o * count, sent + (o + 1) * count,
+                            [](double i) { return i <= 0.0; }))
+                continue;
+            const glm::dvec3& omega = directions.Direction(o);
+            double out = 0.0, squares = 0.0;
+            for (int k = 0; k < kRaysPerBin; ++k) {
+                // A point of the box, the ray leaving it where the box ends.
+                const glm::dvec3 local =
+                    glm::mix(node.boxMin, node.boxMax,
+                             glm::dvec3(random.Uniform(), random.Uniform(), random.Uniform()));
+                const glm::dvec3 p(node.sceneFromInstance * glm::dvec4(local, 1.0));
+                const double exit = std::max(occlusion.ChordOf(self, p, omega).exit, 0.0);
+                const double passed = occlusion.Transmittance(
+                    {p + exit * omega}, omega, std::numeric_limits<double>::infinity(), {&self, 1});
+                out += passed, squares += passed * passed;
+            }
+            traced[c] += kRaysPerBin;
+            const double fraction = out / kRaysPerBin;
+            const double doubt =
+                std::max(0.0, squares / kRaysPerBin - fraction * fraction) / (kRaysPerBin - 1.0);
+            for (int k = 0; k < count; ++k) {
+                const double power = sent[o * count + k] * directions.HatIntegralSr(o);
+                escaped[c][k] += power * fraction;
+                variance[c][k] += power * power * doubt;
+            }
+        }
+    });
+    std::int64_t rays = 0;
+    for (std::size_t c = 0; c < closed; ++c) {
+        rays += traced[c];
+        for (int k = 0; k < count; ++k) {
+            EnergyBalance& balance = balances[channels.BandOf(k)];
+            const double before = std::max(balance.stderrW, 0.0);
+            balance.escapedW += escaped[c][k];
+            balance.stderrW = std::sqrt(before * before + variance[c][k]);
+        }
+    }
+    return rays;
 }
 
 }  // namespace leaflux

@@ -10,6 +10,7 @@
 #include "solver/radiosity/gathering.h"
 #include "solver/radiosity/light_state.h"
 #include "solver/radiosity/node_model.h"
+#include "solver/raytrace/occlusion.h"
 #include "solver/raytrace/raytrace.h"
 #include "solver/results/light.h"
 
@@ -38,10 +39,21 @@ class SolutionSink : public LightSink {
 
 // Hands each receiver of the leaf patches `leaves` to the sink and adds their energy
 // balance to `balances` (one per band); returns the rays it traced. A scene's solve: one
-// channel per band.
+// channel per band. With `occlusion` (a level holding closed instances), the escape rays
+// pass its closed instances by their transmittance, else they meet `rays`' triangles alone.
 std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
                           const std::vector<std::uint32_t>& leaves, const ReceiverOptics& optics,
                           const Field& field, const LeafLight& leafLight, LightSink& sink,
-                          std::vector<EnergyBalance>& balances);
+                          std::vector<EnergyBalance>& balances,
+                          const Occlusion* occlusion = nullptr);
+
+// Adds to `balances` the power the closed instances send out of the scene: per instance and
+// bin of the cluster light's set, what it sends that way (its intensity times the bin's
+// solid angle) times the fraction of rays from points of its box, along the bin's
+// direction, that pass the rest of the scene (triangles block them, other closed instances
+// pass them by their transmittance). Its standard error goes into stderrW. Returns the rays
+// traced.
+std::int64_t AddClosedEscape(const NodeModel& model, const Occlusion& occlusion, const Field& field,
+                             std::vector<EnergyBalance>& balances);
 
 }  // namespace leaflux

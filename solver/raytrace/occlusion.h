@@ -110,6 +110,8 @@ class Occlusion {
     Chord ChordOf(std::uint32_t c, const glm::dvec3& origin, const glm::dvec3& direction) const;
 
     std::size_t ProxyCount() const { return proxies_.size(); }
+    // A local problem's, with the level it was opened in around it.
+    bool HasOutside() const { return outside_.occlusion != nullptr; }
     const ShadowView& Shadows() const { return shadows_; }
     // Triangles alone, nothing outside: a ray passes or not (traced in batches).
     bool TrianglesOnly() const { return proxies_.empty() && outside_.occlusion == nullptr; }
