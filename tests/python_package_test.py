@@ -444,11 +444,12 @@ def test_render_draws_the_last_cycles_light():
                 raise AssertionError(f"{bad} was drawn")
             except ValueError as e:
                 assert next(iter(bad)) in str(e), e
-        try:
-            client.render(session, eye=(0, 0, 3), look=(0, 0, 1), band="NIR")
-            raise AssertionError("a band the scene lacks was drawn")
-        except NotFound as e:
-            assert e.field == "render.band", e
+        for bad, field in (({"band": "NIR"}, "render.band"), ({"quantity": "colour"}, "render.rgb[0]")):
+            try:
+                client.render(session, eye=(0, 0, 3), look=(0, 0, 1), **bad)
+                raise AssertionError(f"{bad}: a band the scene lacks was drawn")
+            except NotFound as e:
+                assert e.field == field, e
 
 
 def test_resync_after_a_restart():

@@ -263,8 +263,8 @@ class Client:
         """A picture of `session`'s scene in the light its last cycle returned (that cycle
         must have asked for leaves), drawn by the daemon as `leaflux render` draws it.
 
-        `quantity`: irradiance, absorbed, radiosity or true_colour (the `rgb` bands, default
-        R, G, B); `side`: seen, upper, lower or both; `value_range`: (min, max) of the
+        `quantity`: irradiance, absorbed, radiosity or colour (true colour from the `rgb`
+        bands, default R, G, B); `side`: seen, upper, lower or both; `value_range`: (min, max) of the
         colour scale (default 0 to the largest value in view); `palette`: viridis or grey.
         The reply's `png` holds the PNG file's bytes, `caption`, `scale_min`, `scale_max`
         what the colour bar shows."""
@@ -276,7 +276,9 @@ class Client:
         r.camera.fov_deg = fov_deg
         r.width, r.height = size
         r.pixel_samples = pixel_samples
-        r.quantity = _enum(pb.RenderQuantity, "RENDER_QUANTITY_", quantity, "quantity")
+        # The names of `leaflux render --quantity`: colour is RENDER_QUANTITY_TRUE_COLOUR.
+        r.quantity = _enum(pb.RenderQuantity, "RENDER_QUANTITY_",
+                           "true_colour" if quantity == "colour" else quantity, "quantity")
         r.side = _enum(pb.RenderSide, "RENDER_SIDE_", side, "side")
         r.band = band
         r.rgb.extend(rgb)
