@@ -156,13 +156,8 @@ int RunRender(const RenderCommand& command) {
             if (solve.solver != "instanced")
                 throw InputError(ErrorCode::kInvalidArgument, "--open-in-view",
                                  "is for --solver instanced");
-            const RenderSettings settings = [&] {
-                RenderSettings s;
-                s.camera = ParseCamera(command.camera);
-                std::tie(s.width, s.height) = ParseSize(command.size);
-                return s;
-            }();
-            const View view(settings.camera, settings.width, settings.height);
+            const auto [width, height] = ParseSize(command.size);
+            const View view(ParseCamera(command.camera), width, height);
             solve.instanced.inView = [view](const glm::dvec3& low, const glm::dvec3& high) {
                 return view.MaySee(low, high);
             };

@@ -34,6 +34,7 @@ RenderSettings SettingsOf(const v1::RenderRequest& in, const Scene& scene) {
                        "at most " + std::to_string(kMaxPictureSide) + " pixels a side");
     if (in.width() != 0) settings.width = static_cast<int>(in.width());
     if (in.height() != 0) settings.height = static_cast<int>(in.height());
+    // Beyond 1024 it stays beyond (no wrap into an int), for Validate to refuse naming it.
     if (in.pixel_samples() != 0)
         settings.samples = static_cast<int>(std::min(in.pixel_samples(), 1025u));
     if (static_cast<double>(settings.width) * settings.height * settings.samples > kMaxPictureRays)

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <chrono>
 #include <glm/gtc/matrix_transform.hpp>
-#include <limits>
 #include <mutex>
 #include <numbers>
 #include <tuple>
@@ -18,6 +17,7 @@
 #include "solver/instancing/signature.h"
 #include "solver/raytrace/occlusion.h"
 #include "solver/scene/geometry.h"
+#include "solver/util/box.h"
 #include "solver/util/check.h"
 #include "solver/util/directions.h"
 #include "solver/util/error.h"
@@ -370,15 +370,7 @@ bool InstancedSolve::HoldsInstanceOf(std::uint32_t q, NodeType type) const {
 bool InstancedSolve::Opens(std::uint32_t q, const glm::dmat4& worldFromRoot) const {
     if (options_.maxDepth > 0 && tree_[q].depth > options_.maxDepth) return false;
     if (options_.inView) {
-        glm::dvec3 low(std::numeric_limits<double>::infinity()), high(-low);
-        for (int corner = 0; corner < 8; ++corner) {
-            const glm::dvec3 local(corner & 1 ? tree_[q].boxMax.x : tree_[q].boxMin.x,
-                                   corner & 2 ? tree_[q].boxMax.y : tree_[q].boxMin.y,
-                                   corner & 4 ? tree_[q].boxMax.z : tree_[q].boxMin.z);
-            const glm::dvec3 world(worldFromRoot * glm::dvec4(local, 1.0));
-            low = glm::min(low, world);
-            high = glm::max(high, world);
-        }
+        const auto [low, high] = PlacedBounds(worldFromRoot, tree_[q].boxMin, tree_[q].boxMax);
         if (!options_.inView(low, high)) return false;
     }
     return !options_.outputLevel || HoldsInstanceOf(q, *options_.outputLevel);

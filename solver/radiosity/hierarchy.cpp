@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "solver/raytrace/raytrace.h"
+#include "solver/util/box.h"
 #include "solver/util/check.h"
 
 namespace leaflux {
@@ -167,9 +168,7 @@ std::uint32_t Hierarchy::AddClosed(std::uint32_t index) {
     }
     node.spread = std::sqrt(second);
     for (int corner = 0; corner < 8; ++corner) {
-        const glm::dvec3 p(corner & 1 ? closed.boxMax.x : closed.boxMin.x,
-                           corner & 2 ? closed.boxMax.y : closed.boxMin.y,
-                           corner & 4 ? closed.boxMax.z : closed.boxMin.z);
+        const glm::dvec3 p = BoxCorner(closed.boxMin, closed.boxMax, corner);
         node.radius = std::max(node.radius, glm::length(linear * (p - middle)));
     }
     nodes_.push_back(node);

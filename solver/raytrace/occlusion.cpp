@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
+#include "solver/util/box.h"
 #include "solver/util/check.h"
 
 namespace leaflux {
@@ -97,16 +99,8 @@ Occlusion::Occlusion(const RayScene& triangles, std::vector<ClosedProxy> proxies
         box.instanceFromScene = glm::inverse(proxy.sceneFromInstance);
         box.boxMin = proxy.boxMin;
         box.boxMax = proxy.boxMax;
-        box.lower = glm::dvec3(std::numeric_limits<double>::infinity());
-        box.upper = -box.lower;
-        for (int corner = 0; corner < 8; ++corner) {
-            const glm::dvec3 p(corner & 1 ? proxy.boxMax.x : proxy.boxMin.x,
-                               corner & 2 ? proxy.boxMax.y : proxy.boxMin.y,
-                               corner & 4 ? proxy.boxMax.z : proxy.boxMin.z);
-            const glm::dvec3 q = glm::dvec3(proxy.sceneFromInstance * glm::dvec4(p, 1.0));
-            box.lower = glm::min(box.lower, q);
-            box.upper = glm::max(box.upper, q);
-        }
+        std::tie(box.lower, box.upper) =
+            PlacedBounds(proxy.sceneFromInstance, proxy.boxMin, proxy.boxMax);
         boxes_.push_back(box);
     }
     RTCDevice rtc = device_->Get();

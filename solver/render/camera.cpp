@@ -6,6 +6,7 @@
 #include <iterator>
 #include <sstream>
 
+#include "solver/util/box.h"
 #include "solver/util/error.h"
 
 namespace leaflux {
@@ -120,9 +121,7 @@ bool View::MaySee(const glm::dvec3& boxMin, const glm::dvec3& boxMax) const {
     const glm::dvec3 right = glm::normalize(right_), down = glm::normalize(down_);
     int outside[5] = {0, 0, 0, 0, 0};
     for (int corner = 0; corner < 8; ++corner) {
-        const glm::dvec3 p(corner & 1 ? boxMax.x : boxMin.x, corner & 2 ? boxMax.y : boxMin.y,
-                           corner & 4 ? boxMax.z : boxMin.z);
-        const glm::dvec3 d = p - eye_;
+        const glm::dvec3 d = BoxCorner(boxMin, boxMax, corner) - eye_;
         const double z = glm::dot(d, forward_), x = glm::dot(d, right), y = glm::dot(d, down);
         outside[0] += z <= 0.0;
         outside[1] += x > z * tanX;

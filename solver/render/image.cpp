@@ -16,14 +16,23 @@ void Image::Paste(const Image& other, int x, int y) {
         for (int i = 0; i < other.Width(); ++i) Set(x + i, y + j, other.At(i, j));
 }
 
-// libpng's simplified API: no setjmp, the error in image.message.
-void WritePng(const Image& image, const std::string& path) {
+namespace {
+
+// libpng's simplified API (no setjmp, the error in png.message): `image` described for it.
+png_image Described(const Image& image) {
     static_assert(sizeof(Rgb) == 3, "pixels are packed RGB");
     png_image png{};
     png.version = PNG_IMAGE_VERSION;
     png.width = static_cast<png_uint_32>(image.Width());
     png.height = static_cast<png_uint_32>(image.Height());
     png.format = PNG_FORMAT_RGB;
+    return png;
+}
+
+}  // namespace
+
+void WritePng(const Image& image, const std::string& path) {
+    png_image png = Described(image);
     const bool written =
         png_image_write_to_file(&png, path.c_str(), 0, &image.At(0, 0), 0, nullptr);
     const std::string message = png.message;
@@ -32,11 +41,7 @@ void WritePng(const Image& image, const std::string& path) {
 }
 
 std::string EncodePng(const Image& image) {
-    png_image png{};
-    png.version = PNG_IMAGE_VERSION;
-    png.width = static_cast<png_uint_32>(image.Width());
-    png.height = static_cast<png_uint_32>(image.Height());
-    png.format = PNG_FORMAT_RGB;
+    png_image png = Described(image);
     // First the size (a null buffer), then the bytes.
     png_alloc_size_t bytes = 0;
     std::string out;
