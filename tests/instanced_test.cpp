@@ -273,6 +273,31 @@ TEST(Instanced, AShadedGroundLightsTheLowerSidesFromUnderThem) {
     }
 }
 
+// Two copies whose crowns grow into one another: each copy's leaves take the other's light
+// from all round them and from inside their own box. Linked as clusters, from the other's
+// centre, their lower sides got 9.3 % (PAR) and 22.5 % (NIR) less than the flattened
+// scene's HRC gives them; taken per direction with the share of the sender's rays the
+// receiver's box stops (closed_exchange.h), 6.0 and 13.6 % less (the test prints them).
+// What is still missing is not found yet; the bounds, 8 and 18 %, hold what was gained.
+TEST(Instanced, OverlappingCrownsExchangeTheirScatteredLight) {
+    const Scene scene = Copies(2, 300, 0.3);
+    const PreparedScene prepared(scene);
+    const Solution hrc = Hrc(prepared, 1e-5);
+    PhaseDatabase database({});
+    InstancedOptions options;
+    options.hrc.epsilon = 1e-5;
+    const InstancedSolution instanced =
+        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+    ASSERT_EQ(instanced.stats.depths.size(), 2u);
+    const std::vector<double> flat = MeanLowerWm2(prepared.Flat(), hrc);
+    const std::vector<double> opened = MeanLowerWm2(prepared.Flat(), instanced.solution);
+    for (std::size_t b = 0; b < flat.size(); ++b) {
+        std::printf("band %zu: lower sides %.3f W/m2 instanced, %.3f flattened (%+.2f %%)\n", b,
+                    opened[b], flat[b], 100.0 * (opened[b] / flat[b] - 1.0));
+        EXPECT_NEAR(opened[b], flat[b], (b == 0 ? 0.08 : 0.18) * flat[b]);
+    }
+}
+
 // Rigid motion of the whole scene: the same light, for instances carry their frames.
 TEST(Instanced, TheSceneMovedAndTurnedGetsTheSameLight) {
     Scene scene = Copies(3, 60);

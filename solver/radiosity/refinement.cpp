@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "solver/radiosity/closed_exchange.h"
 #include "solver/util/check.h"
 
 namespace leaflux {
@@ -58,7 +59,7 @@ Refiner::Verdict Refiner::Judge(const Task& task) const {
         case Task::kPair:
             return JudgePair(task.r, task.s);
         case Task::kSplit:
-            return {SplitChoice(task.r, task.s), {}, 0};
+            return Verdict::Of(SplitChoice(task.r, task.s));
         case Task::kSelf:
             return {};
     }
@@ -94,6 +95,9 @@ void Refiner::Carry(const Task& task, const Verdict& verdict, std::vector<Task>&
             done_ += static_cast<double>(task.share);
             if (task.kind == Task::kSource) {
                 links_.source[r].push_back({s, verdict.visibility});
+            } else if (!verdict.links.empty()) {
+                links_.node[r].insert(links_.node[r].end(), verdict.links.begin(),
+                                      verdict.links.end());
             } else {
                 links_.node[r].push_back(verdict.link);
             }
@@ -122,7 +126,7 @@ Refiner::Verdict Refiner::JudgeSource(std::uint32_t r, std::uint32_t s) const {
     // the link, and none is traced.
     const double threshold = SourceThreshold(r);
     if (unoccluded * VisibilitySpread(1.0, visibility_.SourceRays()) > threshold && CanSplit(r))
-        return {Verdict::kSplitReceiver, {}, 0.0f, 0};
+        return Verdict::Of(Verdict::kSplitReceiver);
     Verdict verdict;
     const double v = visibility_.FromSource(r, s, source, RaySet::kJudging, verdict.rays);
     const double error = unoccluded * VisibilitySpread(v, visibility_.SourceRays());
@@ -161,8 +165,17 @@ Refiner::Verdict::Kind Refiner::SplitChoice(std::uint32_t r, std::uint32_t s) co
     // smaller end beneath it does not make the exchange finer (the 10,000-leaf tree's axes
     // were split 80 times over beside their closed laterals, for the same error and twice
     // the time). The link stands; what it brings into the instance is refined there when the
-    // instance is opened.
-    if (model_.Closed(receiverLarger ? r : s) != nullptr) return Verdict::kNone;
+    // instance is opened. But a cluster whose bounds overlap the closed instance's is split
+    // down to the instances in it, whose links with the closed one are then taken per
+    // direction (closed_exchange.h). Without, on the 10,000-leaf tree without ground, its
+    // lower leaf sides got 20.5 % less NIR than HRC's at ε = 1e-5; with, 4.4 % more.
+    if (const std::uint32_t closed = receiverLarger ? r : s; model_.Closed(closed) != nullptr) {
+        const std::uint32_t other = receiverLarger ? s : r;
+        const HrcNode& cluster = hierarchy_[other];
+        const bool overlapping = !cluster.patch && !model_.Planar(other) &&
+                                 BoundsOverlap(cluster, hierarchy_[closed]) && CanSplit(other);
+        return overlapping ? smaller : Verdict::kNone;
+    }
     if (CanSplit(receiverLarger ? s : r)) return smaller;
     return Verdict::kNone;
 }
@@ -173,6 +186,13 @@ Refiner::Verdict::Kind Refiner::SplitChoice(std::uint32_t r, std::uint32_t s) co
 Refiner::Verdict Refiner::JudgePair(std::uint32_t r, std::uint32_t s) const {
     const bool exact = hierarchy_[r].patch && hierarchy_[s].patch;
     if (exact && Estimator::InPlane(hierarchy_[r], hierarchy_[s])) return {};
+    if (OverlappingClosed(hierarchy_, r, s)) {
+        Verdict verdict;
+        const double v = visibility_.Between(r, s, RaySet::kValuing, verdict.rays).visibility;
+        verdict.links = OverlappingClosedLinks(model_, r, s, v);
+        if (!verdict.links.empty()) verdict.kind = Verdict::kLink;
+        return verdict;
+    }
     Estimate e = exact ? estimator_.Exact(r, s) : estimator_.Pair(r, s);
     if (exact && !e.near && e.form.upper + e.form.lower <= 0.0) return {};
     // Geometry and the least spread any rays could show may call for a split: then no
@@ -180,7 +200,7 @@ Refiner::Verdict Refiner::JudgePair(std::uint32_t r, std::uint32_t s) const {
     const double threshold = Threshold(r);
     if (e.Error(VisibilitySpread(1.0, visibility_.VisibilityRays())) > threshold) {
         if (const auto split = SplitChoice(r, s); split != Verdict::kNone)
-            return {split, {}, 0.0f, 0};
+            return Verdict::Of(split);
     }
     // Past that, the form factor at the points that carry light (ReceiverPoints) is what
     // the rays, the error and the transfer take.

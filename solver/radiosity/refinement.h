@@ -105,6 +105,13 @@ class Refiner {
         NodeLink link;            // kLink of a pair
         float visibility = 0.0f;  // kLink of a source
         std::int64_t rays = 0;
+        std::vector<NodeLink> links;  // kLink of overlapping closed instances, for `link`
+
+        static Verdict Of(Kind kind) {
+            Verdict verdict;
+            verdict.kind = kind;
+            return verdict;
+        }
     };
 
     Verdict Judge(const Task& task) const;

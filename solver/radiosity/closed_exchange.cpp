@@ -1,0 +1,95 @@
+#include "solver/radiosity/closed_exchange.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace leaflux {
+namespace {
+
+// Points of a box spread evenly through it: the centres of a 4 × 4 × 4 grid of its cells.
+constexpr int kCells = 4;
+
+// The share of the line x + t ω, t ≥ 0, of the box [lo, hi] (instance frame) over its whole
+// chord; 0 when the line misses it.
+double ChordShare(const glm::dvec3& x, const glm::dvec3& omega, const glm::dvec3& lo,
+                  const glm::dvec3& hi) {
+    double enter = -std::numeric_limits<double>::infinity();
+    double exit = std::numeric_limits<double>::infinity();
+    for (int axis = 0; axis < 3; ++axis) {
+        if (omega[axis] == 0.0) {
+            if (x[axis] < lo[axis] || x[axis] > hi[axis]) return 0.0;
+            continue;
+        }
+        double t0 = (lo[axis] - x[axis]) / omega[axis];
+        double t1 = (hi[axis] - x[axis]) / omega[axis];
+        if (t0 > t1) std::swap(t0, t1);
+        enter = std::max(enter, t0);
+        exit = std::min(exit, t1);
+    }
+    if (!(exit > enter) || exit <= 0.0) return 0.0;
+    return (exit - std::max(enter, 0.0)) / (exit - enter);
+}
+
+}  // namespace
+
+bool BoundsOverlap(const HrcNode& a, const HrcNode& b) {
+    return glm::length(b.centroid - a.centroid) < a.radius + b.radius;
+}
+
+bool OverlappingClosed(const Hierarchy& hierarchy, std::uint32_t r, std::uint32_t s) {
+    return hierarchy[r].closed >= 0 && hierarchy[s].closed >= 0 &&
+           BoundsOverlap(hierarchy[r], hierarchy[s]);
+}
+
+std::vector<NodeLink> OverlappingClosedLinks(const NodeModel& model, std::uint32_t r,
+                                             std::uint32_t s, double visibility) {
+    const Hierarchy& hierarchy = model.Nodes();
+    const ClosedNode& receiver = hierarchy.Closed()[hierarchy[r].closed];
+    const ClosedNode& sender = hierarchy.Closed()[hierarchy[s].closed];
+    const DirectionSet& directions = model.Directions();
+    const glm::dmat4 receiverFromSender =
+        glm::inverse(receiver.sceneFromInstance) * sender.sceneFromInstance;
+    const glm::dmat3 receiverFromScene = glm::inverse(glm::dmat3(receiver.sceneFromInstance));
+    std::vector<glm::dvec3> points;  // the sender's, in the receiver's frame
+    const glm::dvec3 cell = (sender.boxMax - sender.boxMin) / static_cast<double>(kCells);
+    for (int i = 0; i < kCells; ++i) {
+        for (int j = 0; j < kCells; ++j) {
+            for (int k = 0; k < kCells; ++k) {
+                const glm::dvec3 p = sender.boxMin + cell * glm::dvec3(i + 0.5, j + 0.5, k + 0.5);
+                points.emplace_back(receiverFromSender * glm::dvec4(p, 1.0));
+            }
+        }
+    }
+    std::vector<NodeLink> links;
+    for (int d = 0; d < directions.Size(); ++d) {
+        const glm::dvec3& omega = directions.Direction(d);  // the way the light goes
+        const double facing = model.ProjectedArea(r, -omega);
+        if (facing <= 0.0) continue;
+        const glm::dvec3 along = glm::normalize(receiverFromScene * omega);
+        const double tau = std::clamp(receiver.contents->Transmittance(along), 0.0, 1.0);
+        double stopped = 0.0;
+        for (const glm::dvec3& x : points) {
+            const double share = ChordShare(x, along, receiver.boxMin, receiver.boxMax);
+            if (share > 0.0) stopped += 1.0 - std::pow(tau, share);
+        }
+        stopped /= static_cast<double>(points.size());
+        if (stopped <= 0.0) continue;
+        NodeLink link;
+        link.sender = s;
+        link.ownRays = true;  // its visibility is the pair's, valued once
+        link.toSender = glm::vec3(-omega);
+        link.transfer[0] =
+            static_cast<float>(visibility * directions.HatIntegralSr(d) * stopped / facing);
+        link.receiverBins = Locate(directions, -omega);
+        link.senderBins.index = {static_cast<std::uint16_t>(d), static_cast<std::uint16_t>(d),
+                                 static_cast<std::uint16_t>(d)};
+        link.senderBins.weight = {static_cast<std::uint16_t>(BinWeights::kUnit), 0};
+        link.reach = -1.0f;  // neither end can be split: it stands whatever it carries
+        link.geometricError = 1.0f;
+        links.push_back(link);
+    }
+    return links;
+}
+
+}  // namespace leaflux

@@ -1,0 +1,33 @@
+// The light two closed instances whose bounds overlap hand each other. A link between
+// clusters takes the light as arriving from the sender's centre, with 1/d² between the
+// centres (Estimator::Pair); for two crowns grown into one another that is neither the
+// power nor its direction, for the sender's leaves lie around and inside the receiver.
+// Here the exchange is taken per direction of the sender's light: what it sends along ω,
+// from points spread through its box, times the share of those rays the receiver's box
+// stops by its transmittance over the part of its chord they cross. Two copies of a
+// 300-leaf tree 0.3 m apart, instantiated, gave their leaves' lower sides 22.5 % less NIR
+// than the flattened scene's HRC the first way, 13.6 % less this way
+// (Instanced.OverlappingCrownsExchangeTheirScatteredLight).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "solver/radiosity/links.h"
+#include "solver/radiosity/node_model.h"
+
+namespace leaflux {
+
+// Whether two nodes' bounding spheres overlap.
+bool BoundsOverlap(const HrcNode& a, const HrcNode& b);
+
+// Whether the links s → r are taken per direction: both closed, their bounds overlapping.
+bool OverlappingClosed(const Hierarchy& hierarchy, std::uint32_t r, std::uint32_t s);
+
+// The links s → r, one per direction bin of the sender's light that reaches r: the bin's
+// intensity times its solid angle times the share of its rays r stops, times `visibility`
+// (what else lies between), handed to r as irradiance over r's area facing them.
+std::vector<NodeLink> OverlappingClosedLinks(const NodeModel& model, std::uint32_t r,
+                                             std::uint32_t s, double visibility);
+
+}  // namespace leaflux
