@@ -244,6 +244,27 @@ std::vector<double> MeanLowerWm2(const FlatScene& flat, const Solution& solution
     return mean;
 }
 
+// The scene's plants instantiated and flattened (HRC), both at ε = 1e-5: the leaves' mean
+// lower-side light per band within `bound` (a fraction per band) of the flattened scene's.
+void ExpectLowerSidesNearFlattened(const Scene& scene, const std::vector<double>& bound) {
+    const PreparedScene prepared(scene);
+    const Solution hrc = Hrc(prepared, 1e-5);
+    PhaseDatabase database({});
+    InstancedOptions options;
+    options.hrc.epsilon = 1e-5;
+    const InstancedSolution instanced =
+        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+    ASSERT_EQ(instanced.stats.depths.size(), 2u);
+    const std::vector<double> flat = MeanLowerWm2(prepared.Flat(), hrc);
+    const std::vector<double> opened = MeanLowerWm2(prepared.Flat(), instanced.solution);
+    ASSERT_EQ(flat.size(), bound.size());
+    for (std::size_t b = 0; b < flat.size(); ++b) {
+        std::printf("band %zu: lower sides %.3f W/m2 instanced, %.3f flattened (%+.2f %%)\n", b,
+                    opened[b], flat[b], 100.0 * (opened[b] / flat[b] - 1.0));
+        EXPECT_NEAR(opened[b], flat[b], bound[b] * flat[b]);
+    }
+}
+
 // A tree over a bright ground, which its crown shades: what the ground sends its leaves'
 // lower sides is what the ground under them sends, in its shadow, not what the crown's
 // centre sees of it, and an opened instance holds the ground to take it so. The ground's
@@ -256,21 +277,7 @@ TEST(Instanced, AShadedGroundLightsTheLowerSidesFromUnderThem) {
     scene.optics.push_back({"ground", {{0.6, 0.6, 0.0, 0.0}, {0.6, 0.6, 0.0, 0.0}}});
     scene.environment.push_back({"ground", testing::Rectangle(6, 6, 0), "ground"});
     scene.Validate();
-    const PreparedScene prepared(scene);
-    const Solution hrc = Hrc(prepared, 1e-5);
-    PhaseDatabase database({});
-    InstancedOptions options;
-    options.hrc.epsilon = 1e-5;
-    const InstancedSolution instanced =
-        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
-    ASSERT_EQ(instanced.stats.depths.size(), 2u);
-    const std::vector<double> flat = MeanLowerWm2(prepared.Flat(), hrc);
-    const std::vector<double> opened = MeanLowerWm2(prepared.Flat(), instanced.solution);
-    for (std::size_t b = 0; b < flat.size(); ++b) {
-        std::printf("band %zu: lower sides %.3f W/m2 instanced, %.3f flattened (%+.2f %%)\n", b,
-                    opened[b], flat[b], 100.0 * (opened[b] / flat[b] - 1.0));
-        EXPECT_NEAR(opened[b], flat[b], 0.03 * flat[b]);
-    }
+    ExpectLowerSidesNearFlattened(scene, {0.03, 0.03});
 }
 
 // Two copies whose crowns grow into one another: each copy's leaves take the other's light
@@ -280,22 +287,7 @@ TEST(Instanced, AShadedGroundLightsTheLowerSidesFromUnderThem) {
 // receiver's box stops (closed_exchange.h), 6.0 and 13.6 % less (the test prints them).
 // What is still missing is not found yet; the bounds, 8 and 18 %, hold what was gained.
 TEST(Instanced, OverlappingCrownsExchangeTheirScatteredLight) {
-    const Scene scene = Copies(2, 300, 0.3);
-    const PreparedScene prepared(scene);
-    const Solution hrc = Hrc(prepared, 1e-5);
-    PhaseDatabase database({});
-    InstancedOptions options;
-    options.hrc.epsilon = 1e-5;
-    const InstancedSolution instanced =
-        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
-    ASSERT_EQ(instanced.stats.depths.size(), 2u);
-    const std::vector<double> flat = MeanLowerWm2(prepared.Flat(), hrc);
-    const std::vector<double> opened = MeanLowerWm2(prepared.Flat(), instanced.solution);
-    for (std::size_t b = 0; b < flat.size(); ++b) {
-        std::printf("band %zu: lower sides %.3f W/m2 instanced, %.3f flattened (%+.2f %%)\n", b,
-                    opened[b], flat[b], 100.0 * (opened[b] / flat[b] - 1.0));
-        EXPECT_NEAR(opened[b], flat[b], (b == 0 ? 0.08 : 0.18) * flat[b]);
-    }
+    ExpectLowerSidesNearFlattened(Copies(2, 300, 0.3), {0.08, 0.18});
 }
 
 // Rigid motion of the whole scene: the same light, for instances carry their frames.
