@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
+
+#include "solver/util/box.h"
 
 namespace leaflux {
 namespace {
@@ -14,21 +15,9 @@ constexpr int kCells = 4;
 // chord; 0 when the line misses it.
 double ChordShare(const glm::dvec3& x, const glm::dvec3& omega, const glm::dvec3& lo,
                   const glm::dvec3& hi) {
-    double enter = -std::numeric_limits<double>::infinity();
-    double exit = std::numeric_limits<double>::infinity();
-    for (int axis = 0; axis < 3; ++axis) {
-        if (omega[axis] == 0.0) {
-            if (x[axis] < lo[axis] || x[axis] > hi[axis]) return 0.0;
-            continue;
-        }
-        double t0 = (lo[axis] - x[axis]) / omega[axis];
-        double t1 = (hi[axis] - x[axis]) / omega[axis];
-        if (t0 > t1) std::swap(t0, t1);
-        enter = std::max(enter, t0);
-        exit = std::min(exit, t1);
-    }
-    if (!(exit > enter) || exit <= 0.0) return 0.0;
-    return (exit - std::max(enter, 0.0)) / (exit - enter);
+    const BoxSpan span = LineThroughBox(x, omega, lo, hi);
+    if (!span.Meets() || span.exit <= 0.0) return 0.0;
+    return (span.exit - std::max(span.enter, 0.0)) / (span.exit - span.enter);
 }
 
 }  // namespace

@@ -42,24 +42,9 @@ Occlusion::Chord Occlusion::ChordOf(std::uint32_t c, const glm::dvec3& origin,
     const Box& box = boxes_[c];
     const glm::dvec3 o = glm::dvec3(box.instanceFromScene * glm::dvec4(origin, 1.0));
     const glm::dvec3 d = glm::dmat3(box.instanceFromScene) * direction;
-    Chord chord{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
-                glm::dvec3(0.0)};
-    double enter = -std::numeric_limits<double>::infinity();
-    double exit = std::numeric_limits<double>::infinity();
-    for (int axis = 0; axis < 3; ++axis) {
-        if (d[axis] == 0.0) {
-            if (o[axis] < box.boxMin[axis] || o[axis] > box.boxMax[axis]) return chord;
-            continue;
-        }
-        double t0 = (box.boxMin[axis] - o[axis]) / d[axis];
-        double t1 = (box.boxMax[axis] - o[axis]) / d[axis];
-        if (t0 > t1) std::swap(t0, t1);
-        enter = std::max(enter, t0);
-        exit = std::min(exit, t1);
-    }
-    chord.enter = enter;
-    chord.exit = exit;
-    if (exit > enter) chord.direction = glm::normalize(d);  // only for a line that meets it
+    const BoxSpan span = LineThroughBox(o, d, box.boxMin, box.boxMax);
+    Chord chord{span.enter, span.exit, glm::dvec3(0.0)};
+    if (span.Meets()) chord.direction = glm::normalize(d);  // only for a line that meets it
     return chord;
 }
 

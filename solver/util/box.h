@@ -1,6 +1,8 @@
-// An axis-aligned box's corners, and the world bounds of a box placed by a transform.
+// An axis-aligned box's corners, the world bounds of a box placed by a transform, and where
+// a line crosses it.
 #pragma once
 
+#include <algorithm>
 #include <glm/glm.hpp>
 #include <limits>
 #include <utility>
@@ -24,6 +26,32 @@ inline std::pair<glm::dvec3, glm::dvec3> PlacedBounds(const glm::dmat4& outerFro
         upper = glm::max(upper, p);
     }
     return {lower, upper};
+}
+
+// Where the line origin + t d meets [boxMin, boxMax]: t from `enter` to `exit` (in the
+// units of d); exit ≤ enter when it misses the box.
+struct BoxSpan {
+    double enter = -std::numeric_limits<double>::infinity();
+    double exit = std::numeric_limits<double>::infinity();
+    bool Meets() const { return exit > enter; }
+};
+inline BoxSpan LineThroughBox(const glm::dvec3& origin, const glm::dvec3& d,
+                              const glm::dvec3& boxMin, const glm::dvec3& boxMax) {
+    BoxSpan span;
+    for (int axis = 0; axis < 3; ++axis) {
+        if (d[axis] == 0.0) {
+            if (origin[axis] < boxMin[axis] || origin[axis] > boxMax[axis])
+                return {std::numeric_limits<double>::infinity(),
+                        -std::numeric_limits<double>::infinity()};
+            continue;
+        }
+        double t0 = (boxMin[axis] - origin[axis]) / d[axis];
+        double t1 = (boxMax[axis] - origin[axis]) / d[axis];
+        if (t0 > t1) std::swap(t0, t1);
+        span.enter = std::max(span.enter, t0);
+        span.exit = std::min(span.exit, t1);
+    }
+    return span;
 }
 
 }  // namespace leaflux
