@@ -11,7 +11,7 @@ per scene), README.md one summary of the error tables (`report:summary`).
 Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon,
                        daemon-accuracy,soak,rays,render,summary]
                       [--scenes a,b]
-                      [--scaling-solvers hrc,mc]
+                      [--scaling-solvers hrc,mc,instanced,instanced-tau]
        bench_report.py --tables-only [--only ...]   # rewrite from examples/report/, run nothing
 The growth part reads the demo's out/demo/ (run scripts/demo.sh first).
 """
@@ -161,15 +161,19 @@ def scaling_section(build, out, solvers, run=True):
             shutil.copy(os.path.join(out, name), os.path.join(REPORT, name))
     rows = list(csv.DictReader(open(os.path.join(REPORT, "scaling.csv"))))
     table = [f"![scaling]({figure(RESULTS, 'scaling.png')})", "",
-             "| series | leaves | trees | solver | setting | wall s | peak MiB | links |", "|---|---|---|---|---|---|---|---|"]
+             "| series | leaves | trees | solver | setting | wall s | peak MiB | working MiB | links |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        figures = (f"{number(r['wall_s'])} | {number(r['peak_mib'])} | {r['links'] or '–'}"
-                   if r["status"] == "ok" else f"{r['status']} | | ")
+        working = (number(float(r["peak_mib"]) - float(r["loaded_mib"]))
+                   if r.get("loaded_mib") and r["status"] == "ok" else "–")
+        figures = (f"{number(r['wall_s'])} | {number(r['peak_mib'])} | {working} | {r['links'] or '–'}"
+                   if r["status"] == "ok" else f"{r['status']} | | | ")
         table.append(f"| {r['series']} | {int(r['leaves']):,} | {r['trees']} | {r['solver']} | {r['setting']} | "
                      f"{figures} |")
     fits = list(csv.DictReader(open(os.path.join(REPORT, "fits.csv"))))
-    table += ["", "Fitted growth (time ∝ n^a, peak memory ∝ n^b): " + "; ".join(
-        f"{f['solver']} on {f['series']}: a = {f['time_exponent']}, b = {f['memory_exponent']}" for f in fits) + "."]
+    table += ["", "Fitted growth (time ∝ n^a, peak memory ∝ n^b, working memory ∝ n^c): " + "; ".join(
+        f"{f['solver']} on {f['series']}: a = {f['time_exponent']}, b = {f['memory_exponent']}"
+        + (f", c = {f['working_memory_exponent']}" if f.get("working_memory_exponent") else "") for f in fits) + "."]
     return "\n".join(table)
 
 
@@ -180,10 +184,10 @@ DEMO_FILES = [("growth_comparison.csv", "growth_comparison.csv"), ("growth_compa
               ("growth.png", "demo_growth.png"),
               ("instancing_comparison.csv", "instancing_comparison.csv"),
               ("instancing_comparison.png", "instancing_comparison.png"),
-              ("instancing_above_10_comparison.csv", "instancing_above_10_comparison.csv"),
+              ("instancing_every_comparison.csv", "instancing_every_comparison.csv"),
               ("instanced/cycles.csv", "demo_cycles_instanced.csv"),
               *[(f"cycle{c}.png", f"demo_cycle{c}.png") for c in (2, 9, 13, 17, 25)],
-              ("instanced_above_10/cycles.csv", "demo_cycles_instanced_above_10.csv")]
+              ("instanced_every/cycles.csv", "demo_cycles_instanced_every.csv")]
 
 
 def growth_section(demo, run=True):
@@ -206,29 +210,30 @@ def growth_section(demo, run=True):
 
 
 def instancing_section():
-    """The demo's plant grown with HRC against the one grown with instancing, and with
-    instancing of structures of more than 10 leaves (paper Fig. 15), every 5 cycles."""
-    every = list(csv.DictReader(open(os.path.join(REPORT, "instancing_comparison.csv"))))
-    above = {r["cycle"]: r for r in csv.DictReader(open(os.path.join(REPORT, "instancing_above_10_comparison.csv")))}
+    """The demo's plant grown with HRC against the one grown with instancing (the default
+    policy: structures of more than 10 leaves, paper Fig. 15's blue curve), and with
+    instancing of every structure (its red curve), every 5 cycles."""
+    default = list(csv.DictReader(open(os.path.join(REPORT, "instancing_comparison.csv"))))
+    every = {r["cycle"]: r for r in csv.DictReader(open(os.path.join(REPORT, "instancing_every_comparison.csv")))}
     runs = {run: {r["cycle"]: r for r in csv.DictReader(open(os.path.join(REPORT, f"demo_cycles_{run}.csv")))}
-            for run in ("instanced", "instanced_above_10")}
+            for run in ("instanced", "instanced_every")}
     table = [f"![instancing comparison]({figure(RESULTS, 'instancing_comparison.png')})", "",
-             "| cycle | phytomers | distance % to HRC: instanced / above 10 leaves | per phytomer, max / σ %: "
-             "instanced / above 10 | solve s HRC / instanced / above 10 | phase functions computed so far: "
-             "instanced / above 10 |", "|---|---|---|---|---|---|"]
+             "| cycle | phytomers | distance % to HRC: instanced / every structure | per phytomer, max / σ %: "
+             "instanced / every structure | solve s HRC / instanced / every structure | phase functions computed "
+             "so far: instanced / every structure |", "|---|---|---|---|---|---|"]
     computed = {run: 0 for run in runs}
-    for r in every:
+    for r in default:
         c = r["cycle"]
         for run in runs:
             computed[run] += int(runs[run][c]["phase_computed"])
         if int(c) % 5 == 0:
-            a = above[c]
+            a = every[c]
             table.append(f"| {c} | {r['phytomers_hrc']} | {r['structural_distance_pct']} / "
                          f"{a['structural_distance_pct']} | {number(r['phytomer_distance_max_pct'])} / "
                          f"{number(r['phytomer_distance_sd_pct'])}, {number(a['phytomer_distance_max_pct'])} / "
                          f"{number(a['phytomer_distance_sd_pct'])} | {number(r['solve_s_hrc'])} / "
-                         f"{number(r['solve_s_instanced'])} / {number(a['solve_s_instanced_above_10_leaves'])} | "
-                         f"{computed['instanced']} / {computed['instanced_above_10']} |")
+                         f"{number(r['solve_s_instanced'])} / {number(a['solve_s_instanced_every_structure'])} | "
+                         f"{computed['instanced']} / {computed['instanced_every']} |")
     return "\n".join(table)
 
 
@@ -675,7 +680,7 @@ def main():
     parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon,daemon-accuracy,soak,rays,render",
                         help="parts to run (default: all)")
     parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
-    parser.add_argument("--scaling-solvers", default="hrc,mc",
+    parser.add_argument("--scaling-solvers", default="hrc,mc,instanced,instanced-tau",
                         help="solvers the scaling run measures; the others' rows are kept from OUT_DIR")
     parser.add_argument("--demo", default=os.path.join(ROOT, "out", "demo"),
                         help="growth part: the output of scripts/demo.sh (default: out/demo)")

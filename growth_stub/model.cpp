@@ -486,8 +486,14 @@ std::vector<GrowthModel::LeafInfo> GrowthModel::Leaves() const {
     for (const Plant& plant : plants_) {
         for (const Phytomer& p : plant.phytomers) {
             if (p.leaf == 0) continue;
+            std::vector<NodeId> axes;
+            for (int a = p.axis; a >= 0;) {
+                axes.push_back(plant.axes[a].id);
+                const int bearer = plant.axes[a].bearer;
+                a = bearer < 0 ? -1 : plant.phytomers[bearer].axis;
+            }
             out.push_back({p.leaf, plant.axes[p.axis].id, plant.id,
-                           Species().specific_leaf_area_m2_per_g() * p.leafG});
+                           Species().specific_leaf_area_m2_per_g() * p.leafG, std::move(axes)});
         }
     }
     return out;

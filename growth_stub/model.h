@@ -84,6 +84,8 @@ class GrowthModel {
     struct LeafInfo {
         NodeId leaf = 0, axis = 0, plant = 0;
         double areaM2 = 0.0;
+        // Its axis and the axes bearing it, to the main axis.
+        std::vector<NodeId> axes;
     };
     std::vector<LeafInfo> Leaves() const;
     // Every phytomer by its topological address, the same in two runs of one scenario

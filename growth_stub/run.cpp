@@ -46,7 +46,9 @@ LeafLight FromBand(const v1::BandLight& b) {
 // and light vector, and its axis's absorbed power per m² times its area (stems included:
 // a coarser answer, for models that only need it). An axis the instanced solver solved
 // whole has no irradiance of its own (NaN): its leaves' is then what they absorb over
-// `leafAbsorptance`.
+// `leafAbsorptance`. A leaf whose axis has no light of its own (a shoot too small for the
+// policy to instantiate, inside an axis solved whole) takes that of the nearest axis
+// bearing it that has.
 std::map<NodeId, LeafLight> LeafLightOf(const v1::CycleResult& result, const GrowthModel& model,
                                         const std::string& band, bool branchLight,
                                         double leafAbsorptance) {
@@ -69,7 +71,9 @@ std::map<NodeId, LeafLight> LeafLightOf(const v1::CycleResult& result, const Gro
     }
     std::map<NodeId, LeafLight> light;
     for (const GrowthModel::LeafInfo& leaf : model.Leaves()) {
-        const auto it = byNode.find(branchLight ? leaf.axis : leaf.leaf);
+        auto it = byNode.find(branchLight ? leaf.axis : leaf.leaf);
+        for (std::size_t a = 1; branchLight && it == byNode.end() && a < leaf.axes.size(); ++a)
+            it = byNode.find(leaf.axes[a]);
         if (it == byNode.end()) {
             throw std::runtime_error("cycle " + std::to_string(result.number()) + ": leaf " +
                                      std::to_string(leaf.leaf) + " got no light");

@@ -2,10 +2,11 @@
 # The main job: starts leafluxd, grows the `wall-hole` plant (a plant in a room lit only
 # through a hole in a wall) for 25 cycles with leaflux-grow, writes its CSVs, the PLY and
 # pictures of cycles 2, 9, 13, 17 and 25 and a growth plot, grows it again with direct
-# light only, with instancing (the instanced solver; its phase functions kept in the
-# daemon's database, by default under ~/.local/share/leaflux) and with instancing limited to
-# structures of more than 10 leaves, compares each with the first plant organ by organ
-# (paper Fig. 19 and 15), then stops the daemon cleanly; all in out/demo/.
+# light only, with instancing (the instanced solver and its default policy, which leaves
+# structures of 10 leaves or fewer to the structure holding them; its phase functions kept
+# in the daemon's database, by default under ~/.local/share/leaflux) and with instancing of
+# every structure, compares each with the first plant organ by organ (paper Fig. 19 and
+# 15), then stops the daemon cleanly; all in out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -50,8 +51,8 @@ start_daemon
 stop_daemon
 start_daemon
 "$B/growth_stub/leaflux-grow" --scenario growth_stub/scenarios/wall-hole.txtpb --cycles 25 \
-    --endpoint "$endpoint" --out "$out/instanced_above_10" --solver instanced \
-    --policy proto/policies/above_10_leaves.txtpb --quiet | tee -a "$out/grow.txt"
+    --endpoint "$endpoint" --out "$out/instanced_every" --solver instanced \
+    --policy proto/policies/every_structure.txtpb --quiet | tee -a "$out/grow.txt"
 stop_daemon
 
 /usr/bin/python3 examples/plot_growth.py "$out" "full light" "$out/direct_only" "direct light only"
@@ -59,9 +60,9 @@ stop_daemon
     "$out/growth_comparison"
 /usr/bin/python3 examples/compare_growth.py "$out" hrc "$out/instanced" instanced \
     "$out/instancing_comparison"
-/usr/bin/python3 examples/compare_growth.py "$out" hrc "$out/instanced_above_10" \
-    instanced_above_10_leaves "$out/instancing_above_10_comparison"
+/usr/bin/python3 examples/compare_growth.py "$out" hrc "$out/instanced_every" \
+    instanced_every_structure "$out/instancing_every_comparison"
 echo "results in $out/: cycles.csv plants.csv phytomers.csv cycle{2,9,13,17,25}.{ply,scene.txtpb,csv,png}" \
      "growth.png growth_comparison.{csv,png} instancing_comparison.{csv,png}" \
-     "instancing_above_10_comparison.{csv,png} grow.txt direct_only/ instanced/" \
-     "instanced_above_10/ leafluxd.log"
+     "instancing_every_comparison.{csv,png} grow.txt direct_only/ instanced/" \
+     "instanced_every/ leafluxd.log"

@@ -14,7 +14,8 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
     solve.add_option("--policy", command.policy,
                      "instanced: instantiation policy file (protobuf text format, "
                      "leaflux.v1.InstancingPolicy); default: the built-in general policy, "
-                     "plants and axes by their leaf count in orders of magnitude");
+                     "plants and axes of more than 10 leaves by their leaf count in orders of "
+                     "magnitude");
     solve
         .add_option("--phase-db", command.phaseDb,
                     "instanced: phase-function database file, read and extended")
@@ -47,7 +48,8 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
     solve
         .add_option("--output-level", command.outputLevel,
                     "instanced: light per structure of this type: an instance is opened only "
-                    "while it holds instances of the type, the others are solved whole "
+                    "while it holds instances of the type (or, of another type, structures "
+                    "of the type that are not instances), the others are solved whole "
                     "(--structures) and their leaves never built; e.g. axis for light per "
                     "branch")
         ->check(CLI::IsMember({"plant", "axis", "phytomer"}))

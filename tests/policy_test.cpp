@@ -97,7 +97,7 @@ Scene GeneratedTree(int leaves, std::uint64_t seed = 3) {
 }
 
 TEST(PolicyFile, ShippedPoliciesParseAndValidate) {
-    for (const char* name : {"default.txtpb", "generated_tree.txtpb"}) {
+    for (const char* name : {"default.txtpb", "every_structure.txtpb", "generated_tree.txtpb"}) {
         SCOPED_TRACE(name);
         const InstancingPolicy policy = LoadPolicyFile(PolicyPath(name));
         EXPECT_NO_THROW(ValidatePolicy(policy));
@@ -109,7 +109,11 @@ TEST(PolicyFile, ShippedPoliciesParseAndValidate) {
         EXPECT_EQ(policy.transmittance.level, 3);
     }
     const InstancingPolicy general = LoadPolicyFile(PolicyPath("default.txtpb"));
-    EXPECT_EQ(general.leafCount.edges, (std::vector<double>{1, 10, 100, 1000, 10000}));
+    // Structures of 10 leaves or fewer are left to the structure that holds them; the
+    // policy of every structure bins them too.
+    EXPECT_EQ(general.leafCount.edges, (std::vector<double>{11, 100, 1000, 10000}));
+    EXPECT_EQ(LoadPolicyFile(PolicyPath("every_structure.txtpb")).leafCount.edges,
+              (std::vector<double>{1, 10, 100, 1000, 10000}));
     ASSERT_NE(general.FixedFor(NodeType::kAxis), nullptr);
     EXPECT_EQ(general.FixedFor(NodeType::kAxis)->leafCountAbove, 10000);
     EXPECT_NE(PolicyContentHash(general),
@@ -355,7 +359,7 @@ instance_types: NODE_TYPE_AXIS   # one at a time, in another order
 instance_types: NODE_TYPE_PLANT
 by_type: true
 leaf_count {
-  edges: 1 edges: 10 edges: 100
+  edges: 11 edges: 100
   edges: [1000, 1e4]
 }
 fixed { type: NODE_TYPE_AXIS leaf_count_above: 10000 }
@@ -366,7 +370,7 @@ phase { level: 3 kind: FUNCTION_KIND_MONO }
     EXPECT_EQ(PolicyContentHash(LoadPolicyFile(path)), PolicyContentHash(shipped));
     const std::string changed = Write("changed_policy.txtpb", R"(
 species: "default" instance_types: [NODE_TYPE_PLANT, NODE_TYPE_AXIS] by_type: true
-leaf_count { edges: [1, 10, 100, 1000, 10000] }
+leaf_count { edges: [11, 100, 1000, 10000] }
 fixed { type: NODE_TYPE_PLANT leaf_count_above: 10000 }
 fixed { type: NODE_TYPE_AXIS leaf_count_above: 10001 }
 phase { kind: FUNCTION_KIND_MONO direction_count: 130 }

@@ -124,6 +124,8 @@ class InstancedSolve {
     // outputLevel, inView).
     bool Opens(std::uint32_t q, const glm::dmat4& worldFromRoot) const;
     bool HoldsInstanceOf(std::uint32_t q, NodeType type) const;
+    // Whether a node of `type` lies in part q under its root, in it or in its instances.
+    bool HoldsNodeOf(std::uint32_t q, NodeType type) const;
     // Closed instance c of `level` solved whole from the light that arrived on it.
     void SolveWhole(const Level& level, const LevelSolution& light, std::size_t c);
     // Marks the organs of part q and of the parts in it unsolved; their count and area.
@@ -247,6 +249,7 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     problem.sources = std::move(sources);
     problem.errorW = errorW_;
     problem.sourceCount = sourceCount_;
+    if (p == InstanceTree::kTop) problem.organs = &receivers_;  // ε as HRC takes it
     problem.splitSurfaces = true;  // the surfaces' light, held by the contents (Build)
     LevelSolution light = SolveLevel(level.scene, level.flat, *level.rays, options_.hrc,
                                      level.closed, std::move(problem));
@@ -367,13 +370,30 @@ bool InstancedSolve::HoldsInstanceOf(std::uint32_t q, NodeType type) const {
     return false;
 }
 
+bool InstancedSolve::HoldsNodeOf(std::uint32_t q, NodeType type) const {
+    for (std::size_t i : tree_[q].nodes) {
+        if (i != tree_[q].rootIndex && scene_.nodes[i].type == type) return true;
+    }
+    for (std::uint32_t inner : tree_[q].instances) {
+        if (scene_.nodes[tree_[inner].rootIndex].type == type || HoldsNodeOf(inner, type))
+            return true;
+    }
+    return false;
+}
+
 bool InstancedSolve::Opens(std::uint32_t q, const glm::dmat4& worldFromRoot) const {
     if (options_.maxDepth > 0 && tree_[q].depth > options_.maxDepth) return false;
     if (options_.inView) {
         const auto [low, high] = PlacedBounds(worldFromRoot, tree_[q].boxMin, tree_[q].boxMax);
         if (!options_.inView(low, high)) return false;
     }
-    return !options_.outputLevel || HoldsInstanceOf(q, *options_.outputLevel);
+    if (!options_.outputLevel) return true;
+    // Down to the smallest structures of the type that are instances; a structure of
+    // another type (a plant, for light per axis) holding structures of the type that are
+    // not instances opens too, so that they are solved.
+    const NodeType type = *options_.outputLevel;
+    return HoldsInstanceOf(q, type) ||
+           (scene_.nodes[tree_[q].rootIndex].type != type && HoldsNodeOf(q, type));
 }
 
 void InstancedSolve::MarkUnsolved(std::uint32_t q, StructureLight& whole) {

@@ -53,8 +53,10 @@ struct InstancedOptions {
     OriginalSettings originals;
     // Where opening stops (Soler 2003 §7.1): an instance deeper than maxDepth (1: the
     // largest; 0: no limit) stays closed, and so does one holding no instance of type
-    // outputLevel when it is set (kAxis: light per branch; the smallest branches' leaves
-    // are never built into a hierarchy). A structure left closed is solved whole from the
+    // outputLevel when it is set (kAxis: light per branch; the smallest branches the
+    // policy instantiates are never built into a hierarchy of their leaves), unless it is
+    // of another type and holds structures of the type that are not instances (a plant
+    // whose axes are too small to be instances opens, so that they are solved). A structure left closed is solved whole from the
     // light that arrived on it and its original (Solution::wholeStructures): its absorbed
     // power is that light times the original's absorption per direction (scaled by organ
     // area as f is); its light vector is that of the light arriving on its box; its

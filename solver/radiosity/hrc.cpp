@@ -236,11 +236,13 @@ class SceneSolve {
     double OrgansProjectedArea(const glm::dvec3& omega) const {
         double area = 0.0;
         bool organs = false;
-        for (const Triangle& t : flat_.triangles) {
-            if (flat_.receivers[t.receiver].kind != ReceiverKind::kOrgan) continue;
+        const FlatScene& flat = level_.organs != nullptr ? *level_.organs : flat_;
+        for (const Triangle& t : flat.triangles) {
+            if (flat.receivers[t.receiver].kind != ReceiverKind::kOrgan) continue;
             organs = true;
             area += t.areaM2 * std::abs(glm::dot(t.normal, omega));
         }
+        if (level_.organs != nullptr && organs) return area;
         for (std::size_t n = 0; n < hierarchy_.Size(); ++n) {
             if (hierarchy_[n].closed < 0) continue;
             organs = true;
