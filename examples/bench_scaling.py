@@ -1,14 +1,19 @@
 #!/usr/bin/python3
 """Time and peak memory against scene size, each solver at one setting, a fresh process
 per run (peak memory is the process's): one generated tree of 1k to 10⁶ leaves, and
-plantations of 1 to 233 trees of 1,000 leaves. Fits the growth exponent of time and
-memory per series and solver (paper §3.5: HRC's n·log n time and super-linear memory are
-the baseline instantiation must beat).
+plantations of 1 to 233 trees of 1,000 leaves. Fits the growth exponent of time, peak
+memory and working memory (the peak less the memory once the scene is loaded) per series
+and solver (paper §3.5: HRC's n·log n time and super-linear memory are the baseline
+instantiation must beat). The instanced solver runs at HRC's ε from a phase-function
+database in OUT_DIR that an earlier run filled (a run that had to compute a function is
+run again), with shadows by geometry (`instanced`, the default) and by transmittance
+(`instanced-tau`, which never holds the whole scene's triangles).
 
 Usage: bench_scaling.py BUILD_DIR OUT_DIR [--leaves 1000,10000,100000,1000000]
                         [--trees 1,4,16,64,233] [--epsilon 1e-5] [--samples 256]
-Writes OUT_DIR/scaling.csv and OUT_DIR/scaling.png and prints the table. A run that fails
-(out of memory) is a row with its exit status and no figures.
+                        [--solvers hrc,mc,instanced,instanced-tau]
+Writes OUT_DIR/scaling.csv, OUT_DIR/fits.csv and OUT_DIR/scaling.png and prints the table.
+A run that fails (out of memory) is a row with its exit status and no figures.
 """
 import argparse
 import csv
@@ -23,6 +28,25 @@ def slope(xs, ys):
     lx, ly = [math.log(x) for x in xs], [math.log(y) for y in ys]
     mx, my = sum(lx) / len(lx), sum(ly) / len(ly)
     return sum((a - mx) * (b - my) for a, b in zip(lx, ly)) / sum((a - mx) ** 2 for a in lx)
+
+
+# solver: (args, database) -> (setting, leaflux solve options)
+SOLVERS = {
+    "hrc": lambda args, db: (args.epsilon, ["--solver", "hrc", "--epsilon", args.epsilon]),
+    "mc": lambda args, db: (args.samples, ["--solver", "mc", "--samples", args.samples]),
+    "instanced": lambda args, db: (args.epsilon, ["--solver", "instanced", "--epsilon", args.epsilon,
+                                                  "--phase-db", db]),
+    "instanced-tau": lambda args, db: (args.epsilon, ["--solver", "instanced", "--epsilon", args.epsilon,
+                                                      "--phase-db", db, "--shadows", "transmittance"]),
+}
+COLUMNS = ["series", "leaves", "trees", "solver", "setting", "wall_s", "cpu_s", "peak_mib", "loaded_mib", "links",
+           "elements", "status"]
+
+
+def working_mib(row):
+    """The solver's working memory: its peak less the process once the scene was loaded
+    (None where the run did not measure it)."""
+    return row["peak_mib"] - row["loaded_mib"] if row.get("loaded_mib") not in ("", None) else None
 
 
 def plantation(leaflux, out_dir, trees):
@@ -49,7 +73,7 @@ def main():
     parser.add_argument("--epsilon", default="1e-5", help="HRC's ε (default: %(default)s)")
     parser.add_argument("--samples", default="256",
                         help="Monte Carlo paths per receiver (default: %(default)s)")
-    parser.add_argument("--solvers", default="hrc,mc",
+    parser.add_argument("--solvers", default=",".join(SOLVERS),
                         help="solvers to run; the rows of the others are kept from OUT/scaling.csv "
                         "(default: %(default)s)")
     args = parser.parse_args()
@@ -61,8 +85,8 @@ def main():
             if r["solver"] not in run_solvers:
                 for key in ("leaves", "trees", "links", "elements"):
                     r[key] = int(r[key]) if r[key] else ""
-                for key in ("wall_s", "cpu_s", "peak_mib"):
-                    r[key] = float(r[key]) if r[key] else ""
+                for key in ("wall_s", "cpu_s", "peak_mib", "loaded_mib"):
+                    r[key] = float(r[key]) if r.get(key) else ""
                 kept[(r["series"], r["leaves"], r["solver"])] = r
     leaflux = os.path.join(args.build, "server", "leaflux")
     os.makedirs(args.out, exist_ok=True)
@@ -73,63 +97,77 @@ def main():
     rows = []
     for series, leaves, trees, make in scenes:
         scene = make()
-        for solver, options in (("hrc", ["--epsilon", args.epsilon]), ("mc", ["--samples", args.samples])):
+        database = os.path.join(args.out, "phase.db")
+        for solver in SOLVERS:
             if solver not in run_solvers:
                 if (series, leaves, solver) in kept:
                     rows.append(kept[(series, leaves, solver)])
                 continue
-            row = dict(series=series, leaves=leaves, trees=trees, solver=solver, setting=options[1])
+            setting, options = SOLVERS[solver](args, database)
+            row = dict(series=series, leaves=leaves, trees=trees, solver=solver, setting=setting)
             try:
-                result = solve(leaflux, scene, os.path.join(args.out, f"{series[0]}{leaves}_{solver}.csv"),
-                               ["--solver", solver] + options)
+                out = os.path.join(args.out, f"{series[0]}{leaves}_{solver}.csv")
+                result = solve(leaflux, scene, out, options)
+                if result.get("phase_computed"):  # its functions are in the database now
+                    result = solve(leaflux, scene, out, options)
                 result.pop("residual_pct")
+                result.pop("phase_computed", None)
                 row.update(result, status="ok")
             except subprocess.CalledProcessError as e:
-                row.update(wall_s="", cpu_s="", peak_mib="", links="", elements="",
+                row.update(wall_s="", cpu_s="", peak_mib="", loaded_mib="", links="", elements="",
                            status=f"failed (exit {e.returncode})")
             rows.append(row)
             print(f"{series:<9} {leaves:>8} {trees:>4} {solver:<4} {row['status']:<16} "
                   f"{row['wall_s']!s:>9} s {row['peak_mib']!s:>7} MiB", flush=True)
     with open(os.path.join(args.out, "scaling.csv"), "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        writer = csv.DictWriter(f, fieldnames=COLUMNS, restval="")
         writer.writeheader()
         writer.writerows(rows)
     fits = []
     for series in dict.fromkeys(r["series"] for r in rows):
-        for solver in ("hrc", "mc"):
+        for solver in SOLVERS:
             points = [r for r in rows if r["series"] == series and r["solver"] == solver and r["status"] == "ok"]
             if len(points) > 1:
                 n = [p["leaves"] for p in points]
+                working = [working_mib(p) for p in points]
                 fits.append((series, solver, slope(n, [p["wall_s"] for p in points]),
-                             slope(n, [p["peak_mib"] for p in points]), min(n), max(n)))
+                             slope(n, [p["peak_mib"] for p in points]),
+                             slope(n, working) if all(working) else "", min(n), max(n)))
     with open(os.path.join(args.out, "fits.csv"), "w", newline="") as f:
         writer = csv.writer(f)
-        writer.writerow(["series", "solver", "time_exponent", "memory_exponent", "from_leaves", "to_leaves"])
-        writer.writerows([s, v, round(t, 3), round(m, 3), a, b] for s, v, t, m, a, b in fits)
-    for series, solver, t, m, a, b in fits:
-        print(f"{series}, {solver}: time grows as n^{t:.2f}, peak memory as n^{m:.2f} ({a:,} to {b:,} leaves)")
+        writer.writerow(["series", "solver", "time_exponent", "memory_exponent", "working_memory_exponent",
+                         "from_leaves", "to_leaves"])
+        writer.writerows([s, v, round(t, 3), round(m, 3), round(w, 3) if w != "" else "", a, b]
+                         for s, v, t, m, w, a, b in fits)
+    for series, solver, t, m, w, a, b in fits:
+        working = f", working memory as n^{w:.2f}" if w != "" else ""
+        print(f"{series}, {solver}: time grows as n^{t:.2f}, peak memory as n^{m:.2f}{working} "
+              f"({a:,} to {b:,} leaves)")
     try:
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
         return
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, axes = plt.subplots(1, 3, figsize=(16, 4.6))
     for series, style in (("one tree", "-"), ("trees", "--")):
-        for solver, marker in (("hrc", "s"), ("mc", "o")):
+        for solver, marker in zip(SOLVERS, ("s", "o", "^", "v")):
             points = [r for r in rows if r["series"] == series and r["solver"] == solver and r["status"] == "ok"]
             if not points:
                 continue
             label = f"{solver}, {series}"
-            for ax, column in zip(axes, ("wall_s", "peak_mib")):
-                ax.loglog([p["leaves"] for p in points], [p[column] for p in points], style, marker=marker,
-                          label=label)
-    for ax, title in zip(axes, ("wall time (s, 2 cores)", "peak memory (MiB)")):
+            values = ([p["wall_s"] for p in points], [p["peak_mib"] for p in points],
+                      [working_mib(p) for p in points])
+            for ax, ys in zip(axes, values):
+                if all(ys):
+                    ax.loglog([p["leaves"] for p in points], ys, style, marker=marker, label=label)
+    for ax, title in zip(axes, ("wall time (s, 2 cores)", "peak memory (MiB)",
+                                "working memory: peak less the loaded scene (MiB)")):
         ax.set_xlabel("leaves")
         ax.set_ylabel(title)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.suptitle(f"HRC at ε = {args.epsilon}, Monte Carlo at {args.samples} paths a leaf")
+        ax.legend(fontsize=7)
+    fig.suptitle(f"HRC and instanced at ε = {args.epsilon}, Monte Carlo at {args.samples} paths a leaf")
     fig.tight_layout()
     fig.savefig(os.path.join(args.out, "scaling.png"), dpi=100)
 

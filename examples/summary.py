@@ -7,14 +7,21 @@ import subprocess
 
 def solve(leaflux, scene, out, options):
     """Solves `scene` into `out` (CSV) and returns the summary's figures: wall_s, cpu_s,
-    peak_mib, links and elements ("" for Monte Carlo), and the energy balance residual in %
-    per band."""
-    line = subprocess.run([leaflux, "solve", "--scene", scene, "--quiet", "--out", out] + options,
-                          check=True, capture_output=True, text=True).stdout.strip().splitlines()[-1]
+    peak_mib, loaded_mib (the process's memory once the scene was loaded: peak_mib less it
+    is the solver's working memory), links and elements ("" for Monte Carlo), the energy
+    balance residual in % per band, and for the instanced solver phase_computed (the phase
+    functions its database lacked)."""
+    output = subprocess.run([leaflux, "solve", "--scene", scene, "--quiet", "--out", out] + options,
+                            check=True, capture_output=True, text=True).stdout
+    line = output.strip().splitlines()[-1]
     found = lambda pattern: re.search(pattern, line)
     row = dict(wall_s=float(found(r" in ([0-9.e+-]+) s").group(1)),
                cpu_s=float(found(r"cpu ([0-9.e+-]+) s").group(1)),
-               peak_mib=int(found(r"peak ([0-9]+) MiB").group(1)))
+               peak_mib=int(found(r"peak ([0-9]+) MiB").group(1)),
+               loaded_mib=int(found(r"\(([0-9]+) MiB with the scene loaded\)").group(1)))
+    computed = re.search(r"phase functions: ([0-9]+) computed", output)
+    if computed:
+        row["phase_computed"] = int(computed.group(1))
     links = found(r"([0-9]+) links, ([0-9]+) elements")
     row["links"], row["elements"] = (int(links.group(1)), int(links.group(2))) if links else ("", "")
     row["residual_pct"] = {band: float(r) for band, r in

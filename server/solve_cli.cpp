@@ -11,6 +11,7 @@
 #include "server/progress.h"
 #include "server/scene_proto.h"
 #include "solver/results/export.h"
+#include "solver/util/memory.h"
 #include "solver/util/error.h"
 
 namespace leaflux {
@@ -105,6 +106,7 @@ std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
     solved->scene = LoadSceneFile(command.scene, ImportOptions{command.strict});
     const Scene& scene = solved->scene;
     if (check) check(scene);
+    const std::int64_t loaded = ResidentBytes();
     // The instanced solver with shadows by transmittance never flattens the scene whole.
     const bool instanced = command.solver == "instanced";
     const bool whole = !instanced || ShadowsByGeometry(command.instanced);
@@ -136,6 +138,7 @@ std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
                            ? RunInstanced(scene, flat, whole ? &solved->prepared->Rays() : nullptr,
                                           settings.hrc, command.instanced)
                            : Solve(*solved->prepared, settings);
+    solved->solution.stats.loadedRssBytes = loaded;
     return solved;
 }
 

@@ -110,7 +110,10 @@ std::string Summary(const std::string& solver, const Scene& scene, const FlatSce
     text << solver << ": " << flat.receivers.size() << " receivers x " << scene.bands.size()
          << " bands in " << Number(stats.wallSeconds) << " s (cpu " << Number(stats.cpuSeconds)
          << " s, " << stats.threads << " threads), peak " << stats.peakRssBytes / (1 << 20)
-         << " MiB, " << stats.rays << " rays";
+         << " MiB";
+    if (stats.loadedRssBytes > 0)
+        text << " (" << stats.loadedRssBytes / (1 << 20) << " MiB with the scene loaded)";
+    text << ", " << stats.rays << " rays";
     if (stats.links > 0) {
         text << ", " << stats.links << " links, " << stats.elements << " elements, "
              << stats.refinementDepth << " levels, " << stats.iterations << " iterations, residual "

@@ -48,6 +48,9 @@ struct SolveStats {
     double wallSeconds = 0.0;
     double cpuSeconds = 0.0;
     std::int64_t peakRssBytes = 0;
+    // The process's resident size once its scene was loaded, before the solve (leaflux
+    // solve; 0: not measured): peakRssBytes less this is the solver's working memory.
+    std::int64_t loadedRssBytes = 0;
     std::int64_t rays = 0;
     int threads = 0;
     // Deterministic solvers: the hierarchy and the iteration.

@@ -19,6 +19,15 @@ std::int64_t PeakRssBytes() {
     return static_cast<std::int64_t>(usage.ru_maxrss) * 1024;  // Linux reports KiB
 }
 
+std::int64_t ResidentBytes() {
+    malloc_trim(0);
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);) {
+        if (line.rfind("VmRSS:", 0) == 0) return std::stoll(line.substr(6)) * 1024;  // kB
+    }
+    return 0;
+}
+
 bool ResetPeakRss() {
     malloc_trim(0);  // what earlier runs freed goes back to the kernel, out of the new peak
     std::ofstream clearRefs("/proc/self/clear_refs");
