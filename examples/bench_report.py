@@ -38,12 +38,12 @@ SCENES = {
     "tree10k": (["--leaves", "10000", "--seed", "2", "--sky-cones", "turtle46"],
                 "generated tree, 10,000 leaves, sun + 46-cone overcast sky",
                 ["--reference-samples", "8192", "--hrc-epsilon", "1e-3,1e-4,5e-5,1e-5,1e-6",
-                 "--instanced-epsilon", "1e-3,1e-4,1e-5", "--instanced-depth", "3,4"]),
+                 "--instanced-epsilon", "1e-3,1e-4,1e-5", "--instanced-depth", "2,3"]),
     "tree119k": (["--leaves", "44500", "--seed", "2", "--sky-cones", "turtle46"],
                  "generated tree of 119k triangles (44,500 leaves and their internodes), "
                  "sun + 46-cone overcast sky",
                  ["--reference-samples", "4096", "--hrc-epsilon", "1e-3,1e-4,1e-5",
-                  "--instanced-epsilon", "1e-3,1e-4,1e-5", "--instanced-depth", "4,5"]),
+                  "--instanced-epsilon", "1e-3,1e-4,1e-5", "--instanced-depth", "3,4"]),
     "canopy": (["--random-canopy", "--canopy-leaves", "2000", "--lai", "5", "--canopy-width", "2",
                 "--seed", "3", "--sky-cones", "turtle46"],
                "dense random canopy, 2,000 leaves, LAI 5, NIR ρ = τ = 0.45, sun + 46-cone sky",
@@ -164,8 +164,8 @@ def scaling_section(build, out, solvers, run=True):
              "| series | leaves | trees | solver | setting | wall s | peak MiB | working MiB | links |",
              "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        working = (number(float(r["peak_mib"]) - float(r["loaded_mib"]))
-                   if r.get("loaded_mib") and r["status"] == "ok" else "–")
+        working = (number(float(r["solving_mib"]) - float(r["loaded_mib"]))
+                   if r.get("solving_mib") and r["status"] == "ok" else "–")
         figures = (f"{number(r['wall_s'])} | {number(r['peak_mib'])} | {working} | {r['links'] or '–'}"
                    if r["status"] == "ok" else f"{r['status']} | | | ")
         table.append(f"| {r['series']} | {int(r['leaves']):,} | {r['trees']} | {r['solver']} | {r['setting']} | "

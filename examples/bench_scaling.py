@@ -2,7 +2,8 @@
 """Time and peak memory against scene size, each solver at one setting, a fresh process
 per run (peak memory is the process's): one generated tree of 1k to 10⁶ leaves, and
 plantations of 1 to 233 trees of 1,000 leaves. Fits the growth exponent of time, peak
-memory and working memory (the peak less the memory once the scene is loaded) per series
+memory and working memory (the peak while solving less the memory once the scene is
+loaded) per series
 and solver (paper §3.5: HRC's n·log n time and super-linear memory are the baseline
 instantiation must beat). The instanced solver runs at HRC's ε from a phase-function
 database in OUT_DIR that an earlier run filled (a run that had to compute a function is
@@ -11,7 +12,7 @@ run again), with shadows by geometry (`instanced`, the default) and by transmitt
 
 Usage: bench_scaling.py BUILD_DIR OUT_DIR [--leaves 1000,10000,100000,1000000]
                         [--trees 1,4,16,64,233] [--epsilon 1e-5] [--samples 256]
-                        [--solvers hrc,mc,instanced,instanced-tau]
+                        [--solvers hrc,mc,instanced,instanced-tau] [--tau-leaves 100000]
 Writes OUT_DIR/scaling.csv, OUT_DIR/fits.csv and OUT_DIR/scaling.png and prints the table.
 A run that fails (out of memory) is a row with its exit status and no figures.
 """
@@ -39,14 +40,15 @@ SOLVERS = {
     "instanced-tau": lambda args, db: (args.epsilon, ["--solver", "instanced", "--epsilon", args.epsilon,
                                                       "--phase-db", db, "--shadows", "transmittance"]),
 }
-COLUMNS = ["series", "leaves", "trees", "solver", "setting", "wall_s", "cpu_s", "peak_mib", "loaded_mib", "links",
-           "elements", "status"]
+COLUMNS = ["series", "leaves", "trees", "solver", "setting", "wall_s", "cpu_s", "peak_mib", "loaded_mib",
+           "solving_mib", "links", "elements", "status"]
 
 
 def working_mib(row):
-    """The solver's working memory: its peak less the process once the scene was loaded
-    (None where the run did not measure it)."""
-    return row["peak_mib"] - row["loaded_mib"] if row.get("loaded_mib") not in ("", None) else None
+    """The solver's working memory: the process's peak while solving less its memory once
+    the scene was loaded (None where the run did not measure it)."""
+    measured = row.get("loaded_mib") not in ("", None) and row.get("solving_mib") not in ("", None)
+    return max(row["solving_mib"] - row["loaded_mib"], 1) if measured else None
 
 
 def plantation(leaflux, out_dir, trees):
@@ -73,6 +75,10 @@ def main():
     parser.add_argument("--epsilon", default="1e-5", help="HRC's ε (default: %(default)s)")
     parser.add_argument("--samples", default="256",
                         help="Monte Carlo paths per receiver (default: %(default)s)")
+    parser.add_argument("--tau-leaves", type=int, default=100000,
+                        help="instanced-tau runs on scenes of at most this many leaves: its "
+                        "shadows through every closed instance's τ take several times the "
+                        "time of shadows by geometry (default: %(default)s)")
     parser.add_argument("--solvers", default=",".join(SOLVERS),
                         help="solvers to run; the rows of the others are kept from OUT/scaling.csv "
                         "(default: %(default)s)")
@@ -85,7 +91,7 @@ def main():
             if r["solver"] not in run_solvers:
                 for key in ("leaves", "trees", "links", "elements"):
                     r[key] = int(r[key]) if r[key] else ""
-                for key in ("wall_s", "cpu_s", "peak_mib", "loaded_mib"):
+                for key in ("wall_s", "cpu_s", "peak_mib", "loaded_mib", "solving_mib"):
                     r[key] = float(r[key]) if r.get(key) else ""
                 kept[(r["series"], r["leaves"], r["solver"])] = r
     leaflux = os.path.join(args.build, "server", "leaflux")
@@ -105,6 +111,10 @@ def main():
                 continue
             setting, options = SOLVERS[solver](args, database)
             row = dict(series=series, leaves=leaves, trees=trees, solver=solver, setting=setting)
+            if solver == "instanced-tau" and leaves > args.tau_leaves:
+                row.update(status=f"not run (over --tau-leaves {args.tau_leaves})")
+                rows.append(row)
+                continue
             try:
                 out = os.path.join(args.out, f"{series[0]}{leaves}_{solver}.csv")
                 result = solve(leaflux, scene, out, options)
@@ -114,7 +124,7 @@ def main():
                 result.pop("phase_computed", None)
                 row.update(result, status="ok")
             except subprocess.CalledProcessError as e:
-                row.update(wall_s="", cpu_s="", peak_mib="", loaded_mib="", links="", elements="",
+                row.update(wall_s="", cpu_s="", peak_mib="", loaded_mib="", solving_mib="", links="", elements="",
                            status=f"failed (exit {e.returncode})")
             rows.append(row)
             print(f"{series:<9} {leaves:>8} {trees:>4} {solver:<4} {row['status']:<16} "
@@ -162,7 +172,7 @@ def main():
                 if all(ys):
                     ax.loglog([p["leaves"] for p in points], ys, style, marker=marker, label=label)
     for ax, title in zip(axes, ("wall time (s, 2 cores)", "peak memory (MiB)",
-                                "working memory: peak less the loaded scene (MiB)")):
+                                "working memory: peak while solving less the loaded scene (MiB)")):
         ax.set_xlabel("leaves")
         ax.set_ylabel(title)
         ax.grid(True, which="both", alpha=0.3)

@@ -7,8 +7,9 @@ import subprocess
 
 def solve(leaflux, scene, out, options):
     """Solves `scene` into `out` (CSV) and returns the summary's figures: wall_s, cpu_s,
-    peak_mib, loaded_mib (the process's memory once the scene was loaded: peak_mib less it
-    is the solver's working memory), links and elements ("" for Monte Carlo), the energy
+    peak_mib (the process's, loading included), loaded_mib (its memory once the scene was
+    loaded) and solving_mib (its peak from then on: less loaded_mib, the solver's working
+    memory), links and elements ("" for Monte Carlo), the energy
     balance residual in % per band, and for the instanced solver phase_computed (the phase
     functions its database lacked)."""
     output = subprocess.run([leaflux, "solve", "--scene", scene, "--quiet", "--out", out] + options,
@@ -18,7 +19,8 @@ def solve(leaflux, scene, out, options):
     row = dict(wall_s=float(found(r" in ([0-9.e+-]+) s").group(1)),
                cpu_s=float(found(r"cpu ([0-9.e+-]+) s").group(1)),
                peak_mib=int(found(r"peak ([0-9]+) MiB").group(1)),
-               loaded_mib=int(found(r"\(([0-9]+) MiB with the scene loaded\)").group(1)))
+               loaded_mib=int(found(r"\(([0-9]+) MiB with the scene loaded").group(1)),
+               solving_mib=int(found(r"([0-9]+) MiB at most while solving").group(1)))
     computed = re.search(r"phase functions: ([0-9]+) computed", output)
     if computed:
         row["phase_computed"] = int(computed.group(1))

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -11,8 +12,8 @@
 #include "server/progress.h"
 #include "server/scene_proto.h"
 #include "solver/results/export.h"
-#include "solver/util/memory.h"
 #include "solver/util/error.h"
+#include "solver/util/memory.h"
 
 namespace leaflux {
 
@@ -106,7 +107,9 @@ std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
     solved->scene = LoadSceneFile(command.scene, ImportOptions{command.strict});
     const Scene& scene = solved->scene;
     if (check) check(scene);
-    const std::int64_t loaded = ResidentBytes();
+    // The solver's working memory: its peak from here less what the loaded scene holds.
+    const std::int64_t loaded = ResidentBytes(), loadingPeak = PeakRssBytes();
+    const bool peakReset = ResetPeakRss();
     // The instanced solver with shadows by transmittance never flattens the scene whole.
     const bool instanced = command.solver == "instanced";
     const bool whole = !instanced || ShadowsByGeometry(command.instanced);
@@ -138,7 +141,12 @@ std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
                            ? RunInstanced(scene, flat, whole ? &solved->prepared->Rays() : nullptr,
                                           settings.hrc, command.instanced)
                            : Solve(*solved->prepared, settings);
-    solved->solution.stats.loadedRssBytes = loaded;
+    SolveStats& stats = solved->solution.stats;
+    if (peakReset) {
+        stats.loadedRssBytes = loaded;
+        stats.solvingPeakRssBytes = PeakRssBytes();
+        stats.peakRssBytes = std::max(stats.solvingPeakRssBytes, loadingPeak);
+    }
     return solved;
 }
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <glm/gtc/matrix_transform.hpp>
 #include <sstream>
 #include <string>
@@ -228,6 +229,43 @@ TEST(Instanced, APlantSolvedWholeAbsorbsWhatItsLeavesDo) {
         EXPECT_NE(line.find(",,,"), std::string::npos) << line;
     }
     EXPECT_EQ(plants, 4 * 2);  // four plants, two bands
+}
+
+// Light per axis where the policy instantiates the plants alone: a plant holds axes that
+// are no instances, so it opens and they are solved, leaf by leaf; nothing below it is an
+// instance, so the light is the light asked per leaf, to the last digit. Left closed as a
+// plant holding no axis instance, its axes would have had no light at all.
+TEST(Instanced, LightPerAxisOpensAPlantWhoseAxesAreNoInstances) {
+    const Scene scene = Copies(2, 60);
+    const PreparedScene prepared(scene);
+    const auto solve = [&](std::optional<NodeType> level) {
+        PhaseDatabase database({});
+        InstancedOptions options;
+        options.hrc.epsilon = 1e-4;
+        options.outputLevel = level;
+        return SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database,
+                              options);
+    };
+    const InstancedSolution perAxis = solve(NodeType::kAxis), perLeaf = solve(std::nullopt);
+    EXPECT_EQ(perAxis.stats.depths[1].opened, 2);
+    EXPECT_EQ(perAxis.stats.depths[1].whole, 0);
+    EXPECT_TRUE(perAxis.solution.wholeStructures.empty());
+    ASSERT_EQ(perAxis.solution.light.size(), perLeaf.solution.light.size());
+    for (std::size_t r = 0; r < perLeaf.solution.light.size(); ++r) {
+        for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+            EXPECT_EQ(perAxis.solution.light[r][b].irradianceUpperWm2,
+                      perLeaf.solution.light[r][b].irradianceUpperWm2);
+            EXPECT_EQ(perAxis.solution.light[r][b].absorbedW,
+                      perLeaf.solution.light[r][b].absorbedW);
+        }
+    }
+    int axes = 0;
+    for (const StructureLight& s : AggregateStructures(scene, prepared.Flat(), perAxis.solution)) {
+        if (s.type != NodeType::kAxis) continue;
+        ++axes;
+        EXPECT_GT(s.bands[0].absorbedW, 0.0) << s.name;
+    }
+    EXPECT_GT(axes, 2);
 }
 
 // The mean light on the leaves' lower sides, per band.

@@ -56,11 +56,11 @@ struct InstancedOptions {
     // outputLevel when it is set (kAxis: light per branch; the smallest branches the
     // policy instantiates are never built into a hierarchy of their leaves), unless it is
     // of another type and holds structures of the type that are not instances (a plant
-    // whose axes are too small to be instances opens, so that they are solved). A structure left closed is solved whole from the
-    // light that arrived on it and its original (Solution::wholeStructures): its absorbed
-    // power is that light times the original's absorption per direction (scaled by organ
-    // area as f is); its light vector is that of the light arriving on its box; its
-    // leaves' irradiances are not solved.
+    // whose axes are too small to be instances opens, so that they are solved). A
+    // structure left closed is solved whole from the light that arrived on it and its
+    // original (Solution::wholeStructures): its absorbed power is that light times the
+    // original's absorption per direction (scaled by organ area as f is); its light vector
+    // is that of the light arriving on its box; its leaves' irradiances are not solved.
     int maxDepth = 0;
     std::optional<NodeType> outputLevel;
     // When set, an instance opens only if this accepts its box in the world (the bounds of

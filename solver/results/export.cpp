@@ -111,8 +111,10 @@ std::string Summary(const std::string& solver, const Scene& scene, const FlatSce
          << " bands in " << Number(stats.wallSeconds) << " s (cpu " << Number(stats.cpuSeconds)
          << " s, " << stats.threads << " threads), peak " << stats.peakRssBytes / (1 << 20)
          << " MiB";
-    if (stats.loadedRssBytes > 0)
-        text << " (" << stats.loadedRssBytes / (1 << 20) << " MiB with the scene loaded)";
+    if (stats.loadedRssBytes > 0 && stats.solvingPeakRssBytes > 0) {
+        text << " (" << stats.loadedRssBytes / (1 << 20) << " MiB with the scene loaded, "
+             << stats.solvingPeakRssBytes / (1 << 20) << " MiB at most while solving)";
+    }
     text << ", " << stats.rays << " rays";
     if (stats.links > 0) {
         text << ", " << stats.links << " links, " << stats.elements << " elements, "

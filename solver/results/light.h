@@ -48,9 +48,10 @@ struct SolveStats {
     double wallSeconds = 0.0;
     double cpuSeconds = 0.0;
     std::int64_t peakRssBytes = 0;
-    // The process's resident size once its scene was loaded, before the solve (leaflux
-    // solve; 0: not measured): peakRssBytes less this is the solver's working memory.
-    std::int64_t loadedRssBytes = 0;
+    // Where leaflux solve measured them (0: not measured): the process's resident size once
+    // its scene was loaded, and its peak from then on, while solving; the second less the
+    // first is the solver's working memory. peakRssBytes is the process's, loading included.
+    std::int64_t loadedRssBytes = 0, solvingPeakRssBytes = 0;
     std::int64_t rays = 0;
     int threads = 0;
     // Deterministic solvers: the hierarchy and the iteration.

@@ -3,17 +3,27 @@
 #include <malloc.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <fstream>
 #include <string>
 
 namespace leaflux {
+namespace {
+
+// A size line of /proc/self/status ("VmHWM:", "VmRSS:"), in bytes; -1 where it has none.
+std::int64_t StatusBytes(const std::string& key) {
+    std::ifstream status("/proc/self/status");
+    for (std::string line; std::getline(status, line);) {
+        if (line.rfind(key, 0) == 0) return std::stoll(line.substr(key.size())) * 1024;  // kB
+    }
+    return -1;
+}
+
+}  // namespace
 
 std::int64_t PeakRssBytes() {
     // VmHWM follows ResetPeakRss; getrusage's maximum never goes down.
-    std::ifstream status("/proc/self/status");
-    for (std::string line; std::getline(status, line);) {
-        if (line.rfind("VmHWM:", 0) == 0) return std::stoll(line.substr(6)) * 1024;  // kB
-    }
+    if (const std::int64_t peak = StatusBytes("VmHWM:"); peak >= 0) return peak;
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     return static_cast<std::int64_t>(usage.ru_maxrss) * 1024;  // Linux reports KiB
@@ -21,11 +31,7 @@ std::int64_t PeakRssBytes() {
 
 std::int64_t ResidentBytes() {
     malloc_trim(0);
-    std::ifstream status("/proc/self/status");
-    for (std::string line; std::getline(status, line);) {
-        if (line.rfind("VmRSS:", 0) == 0) return std::stoll(line.substr(6)) * 1024;  // kB
-    }
-    return 0;
+    return std::max<std::int64_t>(StatusBytes("VmRSS:"), 0);
 }
 
 bool ResetPeakRss() {
