@@ -12,7 +12,7 @@ run again), with shadows by geometry (`instanced`, the default) and by transmitt
 
 Usage: bench_scaling.py BUILD_DIR OUT_DIR [--leaves 1000,10000,100000,1000000]
                         [--trees 1,4,16,64,233] [--epsilon 1e-5] [--samples 256]
-                        [--solvers hrc,mc,instanced,instanced-tau] [--tau-leaves 100000]
+                        [--solvers hrc,mc,instanced,instanced-tau] [--tau-leaves 250000]
 Writes OUT_DIR/scaling.csv, OUT_DIR/fits.csv and OUT_DIR/scaling.png and prints the table.
 A run that fails (out of memory) is a row with its exit status and no figures.
 """
@@ -75,25 +75,26 @@ def main():
     parser.add_argument("--epsilon", default="1e-5", help="HRC's ε (default: %(default)s)")
     parser.add_argument("--samples", default="256",
                         help="Monte Carlo paths per receiver (default: %(default)s)")
-    parser.add_argument("--tau-leaves", type=int, default=100000,
+    parser.add_argument("--tau-leaves", type=int, default=250000,
                         help="instanced-tau runs on scenes of at most this many leaves: its "
                         "shadows through every closed instance's τ take several times the "
                         "time of shadows by geometry (default: %(default)s)")
     parser.add_argument("--solvers", default=",".join(SOLVERS),
-                        help="solvers to run; the rows of the others are kept from OUT/scaling.csv "
-                        "(default: %(default)s)")
+                        help="solvers to run; the rows of the others, and of the scenes not run, "
+                        "are kept from OUT/scaling.csv (default: %(default)s)")
     args = parser.parse_args()
     run_solvers = args.solvers.split(",")
+    # The previous run's rows: those of the solvers not run now, and of the scenes not run
+    # now, are kept.
     kept = {}
     previous = os.path.join(args.out, "scaling.csv")
     if os.path.exists(previous):
         for r in csv.DictReader(open(previous)):
-            if r["solver"] not in run_solvers:
-                for key in ("leaves", "trees", "links", "elements"):
-                    r[key] = int(r[key]) if r[key] else ""
-                for key in ("wall_s", "cpu_s", "peak_mib", "loaded_mib", "solving_mib"):
-                    r[key] = float(r[key]) if r.get(key) else ""
-                kept[(r["series"], r["leaves"], r["solver"])] = r
+            for key in ("leaves", "trees", "links", "elements"):
+                r[key] = int(r[key]) if r[key] else ""
+            for key in ("wall_s", "cpu_s", "peak_mib", "loaded_mib", "solving_mib"):
+                r[key] = float(r[key]) if r.get(key) else ""
+            kept[(r["series"], r["leaves"], r["solver"])] = r
     leaflux = os.path.join(args.build, "server", "leaflux")
     os.makedirs(args.out, exist_ok=True)
     scenes = [("one tree", int(n), 1, lambda n=int(n): generate_tree(leaflux, args.out, n))
@@ -101,6 +102,8 @@ def main():
     scenes += [("trees", 1000 * int(t), int(t), lambda t=int(t): plantation(leaflux, args.out, t))
                for t in args.trees.split(",") if t]
     rows = []
+    run_scenes = {(series, leaves) for series, leaves, _, _ in scenes}
+    rows += [r for (series, leaves, _), r in kept.items() if (series, leaves) not in run_scenes]
     for series, leaves, trees, make in scenes:
         scene = make()
         database = os.path.join(args.out, "phase.db")
@@ -117,6 +120,7 @@ def main():
                 continue
             try:
                 out = os.path.join(args.out, f"{series[0]}{leaves}_{solver}.csv")
+                options = options + ["--max-nodes", "3000000"]  # a tree of 10^6 leaves has 2.3 M
                 result = solve(leaflux, scene, out, options)
                 if result.get("phase_computed"):  # its functions are in the database now
                     result = solve(leaflux, scene, out, options)
@@ -129,6 +133,7 @@ def main():
             rows.append(row)
             print(f"{series:<9} {leaves:>8} {trees:>4} {solver:<4} {row['status']:<16} "
                   f"{row['wall_s']!s:>9} s {row['peak_mib']!s:>7} MiB", flush=True)
+    rows.sort(key=lambda r: (("one tree", "trees").index(r["series"]), r["leaves"], list(SOLVERS).index(r["solver"])))
     with open(os.path.join(args.out, "scaling.csv"), "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=COLUMNS, restval="")
         writer.writeheader()
@@ -161,7 +166,7 @@ def main():
         return
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.6))
     for series, style in (("one tree", "-"), ("trees", "--")):
-        for solver, marker in zip(SOLVERS, ("s", "o", "^", "v")):
+        for solver, marker, colour in zip(SOLVERS, ("s", "o", "^", "v"), ("C0", "C1", "C2", "C3")):
             points = [r for r in rows if r["series"] == series and r["solver"] == solver and r["status"] == "ok"]
             if not points:
                 continue
@@ -170,14 +175,16 @@ def main():
                       [working_mib(p) for p in points])
             for ax, ys in zip(axes, values):
                 if all(ys):
-                    ax.loglog([p["leaves"] for p in points], ys, style, marker=marker, label=label)
+                    ax.loglog([p["leaves"] for p in points], ys, style, marker=marker, color=colour,
+                              label=label)
     for ax, title in zip(axes, ("wall time (s, 2 cores)", "peak memory (MiB)",
-                                "working memory: peak while solving less the loaded scene (MiB)")):
+                                "working memory (MiB)")):
         ax.set_xlabel("leaves")
         ax.set_ylabel(title)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
-    fig.suptitle(f"HRC and instanced at ε = {args.epsilon}, Monte Carlo at {args.samples} paths a leaf")
+    fig.suptitle(f"HRC and instanced at ε = {args.epsilon}, Monte Carlo at {args.samples} paths a leaf; "
+                 "working memory: the peak while solving less the loaded scene")
     fig.tight_layout()
     fig.savefig(os.path.join(args.out, "scaling.png"), dpi=100)
 

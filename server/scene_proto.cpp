@@ -495,13 +495,15 @@ v1::Scene ToProto(const Scene& scene, SceneWriting writing) {
     return message;
 }
 
-Scene LoadSceneFile(const std::string& path, const ImportOptions& options) {
+Scene LoadSceneFile(const std::string& path, const ImportOptions& options,
+                    const SceneLimits& limits) {
     v1::Scene message;
     if (const auto error = ReadTextFormat(path, message)) {
         Fail(error->unreadable ? ErrorCode::kIo : ErrorCode::kParse, error->where,
              error->unreadable ? "cannot open the scene file" : error->what);
     }
-    return FromProto(message, std::filesystem::path(path).parent_path().string(), {}, options);
+    return FromProto(message, std::filesystem::path(path).parent_path().string(), limits,
+                     options);
 }
 
 void SaveSceneFile(const Scene& scene, const std::string& path, SceneWriting writing) {

@@ -77,7 +77,8 @@ void FrameToProto(const glm::dmat4& m, v1::Frame* frame);  // nothing for the id
 void MeshToProto(const Mesh& mesh, v1::Mesh* message);
 
 // Reads a scene file in protobuf text format; parse errors name line and column.
-Scene LoadSceneFile(const std::string& path, const ImportOptions& options = {});
+Scene LoadSceneFile(const std::string& path, const ImportOptions& options = {},
+                    const SceneLimits& limits = {});
 void SaveSceneFile(const Scene& scene, const std::string& path,
                    SceneWriting writing = SceneWriting::kFlat);
 

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "server/instanced_cli.h"
+#include "server/scene_proto.h"
 #include "solver/radiosity/hrc.h"
 #include "solver/solve.h"
 
@@ -22,6 +23,7 @@ inline constexpr const char* kStrictHelp =
 struct SolveCommand {
     std::string scene, solver = "hrc", out, structures, ply;
     int samples = 1024, replicates = 16, threads = 0;
+    std::size_t maxNodes = SceneLimits{}.maxNodes;
     double epsilon = 1e-4;
     HrcOptions hrc;  // subdivision, rays and directions; ε and threads are set apart
     std::uint64_t seed = 1;
@@ -32,6 +34,8 @@ struct SolveCommand {
 // HRC's settings besides ε, as options named `prefix` + name, their help after `label`.
 void AddHrcSettings(CLI::App& app, HrcOptions& hrc, const std::string& prefix,
                     const std::string& label);
+// The command's scene file, within its --max-nodes.
+Scene LoadCommandScene(const SolveCommand& command);
 // The scene, the solver and its settings, as `solve` and `render` take them.
 void AddSolverOptions(CLI::App& app, SolveCommand& command);
 CLI::App* AddSolveCommand(CLI::App& app, SolveCommand& command);
