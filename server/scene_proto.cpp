@@ -370,7 +370,7 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
     }
     if (static_cast<std::size_t>(message.nodes_size()) > limits.maxNodes) {
         throw TooLarge("nodes", "at most " + std::to_string(limits.maxNodes) +
-                                    " nodes a session, got " +
+                                    " nodes a scene (--max-nodes), got " +
                                     std::to_string(message.nodes_size()));
     }
     CountPlacedNodes(message, static_cast<std::size_t>(message.nodes_size()), limits);

@@ -151,7 +151,7 @@ std::size_t CountPlacedNodes(const v1::Scene& message, std::size_t topLevelNodes
         if (total > static_cast<double>(limits.maxNodes)) {
             throw TooLarge("placements", "the nodes and placements make more than " +
                                              std::to_string(limits.maxNodes) +
-                                             " nodes; at most that many a session");
+                                             " nodes; at most that many a scene (--max-nodes)");
         }
     }
     return static_cast<std::size_t>(total) - topLevelNodes;
