@@ -502,8 +502,7 @@ Scene LoadSceneFile(const std::string& path, const ImportOptions& options,
         Fail(error->unreadable ? ErrorCode::kIo : ErrorCode::kParse, error->where,
              error->unreadable ? "cannot open the scene file" : error->what);
     }
-    return FromProto(message, std::filesystem::path(path).parent_path().string(), limits,
-                     options);
+    return FromProto(message, std::filesystem::path(path).parent_path().string(), limits, options);
 }
 
 void SaveSceneFile(const Scene& scene, const std::string& path, SceneWriting writing) {

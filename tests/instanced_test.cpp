@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <optional>
 #include <glm/gtc/matrix_transform.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <unordered_map>
