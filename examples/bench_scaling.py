@@ -3,9 +3,8 @@
 per run (peak memory is the process's): one generated tree of 1k to 10⁶ leaves, and
 plantations of 1 to 233 trees of 1,000 leaves. Fits the growth exponent of time, peak
 memory and working memory (the peak while solving less the memory once the scene is
-loaded) per series
-and solver (paper §3.5: HRC's n·log n time and super-linear memory are the baseline
-instantiation must beat). The instanced solver runs at HRC's ε from a phase-function
+loaded) per series and solver (paper §3.5: HRC's n·log n time and super-linear memory are
+the baseline instantiation must beat). The instanced solver runs at HRC's ε from a phase-function
 database in OUT_DIR that an earlier run filled (a run that had to compute a function is
 run again), with shadows by geometry (`instanced`, the default) and by transmittance
 (`instanced-tau`, which never holds the whole scene's triangles).
@@ -46,7 +45,8 @@ COLUMNS = ["series", "leaves", "trees", "solver", "setting", "wall_s", "cpu_s", 
 
 def working_mib(row):
     """The solver's working memory: the process's peak while solving less its memory once
-    the scene was loaded (None where the run did not measure it)."""
+    the scene was loaded, at least 1 MiB so that its logarithm is fitted (None where the
+    run did not measure it)."""
     measured = row.get("loaded_mib") not in ("", None) and row.get("solving_mib") not in ("", None)
     return max(row["solving_mib"] - row["loaded_mib"], 1) if measured else None
 

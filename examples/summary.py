@@ -9,18 +9,19 @@ def solve(leaflux, scene, out, options):
     """Solves `scene` into `out` (CSV) and returns the summary's figures: wall_s, cpu_s,
     peak_mib (the process's, loading included), loaded_mib (its memory once the scene was
     loaded) and solving_mib (its peak from then on: less loaded_mib, the solver's working
-    memory), links and elements ("" for Monte Carlo), the energy
-    balance residual in % per band, and for the instanced solver phase_computed (the phase
-    functions its database lacked)."""
+    memory), links and elements ("" for Monte Carlo), the energy balance residual in % per
+    band, and for the instanced solver phase_computed (the phase functions its database
+    lacked)."""
     output = subprocess.run([leaflux, "solve", "--scene", scene, "--quiet", "--out", out] + options,
                             check=True, capture_output=True, text=True).stdout
     line = output.strip().splitlines()[-1]
     found = lambda pattern: re.search(pattern, line)
     row = dict(wall_s=float(found(r" in ([0-9.e+-]+) s").group(1)),
                cpu_s=float(found(r"cpu ([0-9.e+-]+) s").group(1)),
-               peak_mib=int(found(r"peak ([0-9]+) MiB").group(1)),
-               loaded_mib=int(found(r"\(([0-9]+) MiB with the scene loaded").group(1)),
-               solving_mib=int(found(r"([0-9]+) MiB at most while solving").group(1)))
+               peak_mib=int(found(r"peak ([0-9]+) MiB").group(1)))
+    # Where the kernel let the peak be reset after loading ("" where it did not).
+    loaded = found(r"\(([0-9]+) MiB with the scene loaded, ([0-9]+) MiB at most while solving\)")
+    row["loaded_mib"], row["solving_mib"] = (int(loaded.group(1)), int(loaded.group(2))) if loaded else ("", "")
     computed = re.search(r"phase functions: ([0-9]+) computed", output)
     if computed:
         row["phase_computed"] = int(computed.group(1))
