@@ -204,7 +204,20 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
         }
         runs.push_back(run);
         if (i == options.instancedEpsilons.size() / 2) {
-            Run single = run;
+            // Directional instance light against the paper's single value. Under a
+            // mono-directional phase function an instance sends alike in every direction
+            // already, and the two are one solve: both are then taken with the policy's
+            // phase function made bi-directional, on its direction set.
+            Run directional = run;
+            if (options.policy.phase.kind != PhaseKind::kBiDirectional) {
+                directional.setting += " phase=bi";
+                directional.settings.instanced.policy.phase.kind = PhaseKind::kBiDirectional;
+                Run cold = directional;  // computing the bi-directional originals
+                cold.setting += " cold";
+                runs.push_back(cold);
+                runs.push_back(directional);
+            }
+            Run single = directional;
             single.setting += " single-value";
             single.settings.hrc.directionalInstances = false;
             runs.push_back(single);

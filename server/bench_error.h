@@ -29,7 +29,9 @@ struct ErrorBenchOptions {
     bool directOnly = true;  // also direct light only (HRC, the finest ε)
     // Instanced runs under `policy`, its originals in one database in memory: the first ε
     // from an empty database ("cold", computing them), then every ε from the full one; at
-    // the middle ε also the paper's single value, shadows by transmittance, light per
+    // the middle ε also directional instance light against the paper's single value (with
+    // the phase function made bi-directional when the policy's is not: "phase=bi", first
+    // "cold", computing its originals), shadows by transmittance, light per
     // branch (output=axis) and opening down to each of `instancedDepths` only; a run that
     // solved structures whole is compared on those structures' absorbed power per organ
     // area (CompareWholeStructures), not on leaves.

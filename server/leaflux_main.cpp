@@ -122,8 +122,9 @@ int main(int argc, char** argv) {
     errorApp
         ->add_option("--instanced-epsilon", errorBench.instancedEpsilons,
                      "Instanced runs: ε of each (none by default); the first also from an empty "
-                     "phase-function database, the middle one also with the single value, "
-                     "with shadows by transmittance and with light per branch "
+                     "phase-function database, the middle one also directional against the "
+                     "single value (phase functions made bi-directional if the policy's are "
+                     "not), with shadows by transmittance and with light per branch "
                      "(--output-level axis)")
         ->delimiter(',')
         ->check(CLI::Range(1e-9, 1.0));
