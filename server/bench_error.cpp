@@ -221,6 +221,12 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
             single.setting += " single-value";
             single.settings.hrc.directionalInstances = false;
             runs.push_back(single);
+            // The light of the level an instance was closed in per direction bin, the same at
+            // each of its points, instead of held and linked into it.
+            Run perBin = run;
+            perBin.setting += " per-bin";
+            perBin.settings.instanced.holdOutside = false;
+            runs.push_back(perBin);
             Run tau = run;
             tau.setting += " shadows=tau";
             tau.settings.instanced.shadowsByGeometry = false;

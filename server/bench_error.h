@@ -31,7 +31,8 @@ struct ErrorBenchOptions {
     // from an empty database ("cold", computing them), then every ε from the full one; at
     // the middle ε also directional instance light against the paper's single value (with
     // the phase function made bi-directional when the policy's is not: "phase=bi", first
-    // "cold", computing its originals), shadows by transmittance, light per
+    // "cold", computing its originals), the outside light per bin (per-bin), shadows by
+    // transmittance, light per
     // branch (output=axis) and opening down to each of `instancedDepths` only; a run that
     // solved structures whole is compared on those structures' absorbed power per organ
     // area (CompareWholeStructures), not on leaves.

@@ -38,6 +38,11 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
     solve.add_flag("--single-value", command.singleValue,
                    "instanced: a closed instance sends its power alike in every direction (the "
                    "paper's single value) instead of by direction");
+    solve.add_flag("--per-bin", command.perBin,
+                   "instanced: an opened instance takes the light of the level it was closed in "
+                   "per direction bin, the same at each of its points, instead of holding that "
+                   "level's patches and closed instances fixed and linking them into its "
+                   "contents (the paper's link copies); cheaper, less accurate in scattered light");
     auto* depth = solve
                       .add_option("--max-depth", command.maxDepth,
                                   "instanced: open instances down to this depth only (1: the "
@@ -71,6 +76,7 @@ Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene*
     InstancedOptions options;
     options.hrc = hrc;
     options.hrc.directionalInstances = !command.singleValue;
+    options.holdOutside = !command.perBin;
     options.maxDepth = command.maxDepth;
     options.inView = command.inView;
     if (!command.outputLevel.empty()) {

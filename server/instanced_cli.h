@@ -17,6 +17,7 @@ struct InstancedCommand {
     double phaseDbMb = 256.0;
     std::string shadows = "geometry";
     bool singleValue = false;
+    bool perBin = false;   // InstancedOptions::holdOutside off
     std::string problems;  // CSV of the local problems solved
     int maxDepth = 0;
     std::string outputLevel;  // "", "plant", "axis" or "phytomer"

@@ -124,8 +124,8 @@ int main(int argc, char** argv) {
                      "Instanced runs: ε of each (none by default); the first also from an empty "
                      "phase-function database, the middle one also directional against the "
                      "single value (phase functions made bi-directional if the policy's are "
-                     "not), with shadows by transmittance and with light per branch "
-                     "(--output-level axis)")
+                     "not), with the outside light per bin (--per-bin), with shadows by "
+                     "transmittance and with light per branch (--output-level axis)")
         ->delimiter(',')
         ->check(CLI::Range(1e-9, 1.0));
     errorApp

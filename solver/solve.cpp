@@ -42,6 +42,7 @@ Solution Solve(const PreparedScene& prepared, const SolverSettings& settings) {
             if (database == nullptr) database = &own.emplace(PhaseDatabaseOptions{});
             InstancedOptions options{
                 settings.hrc, instanced.originals, instanced.maxDepth, instanced.outputLevel, {}};
+            options.holdOutside = instanced.holdOutside;
             InstancedSolution solved =
                 SolveInstanced(prepared.Source(), prepared.Flat(),
                                instanced.shadowsByGeometry ? &prepared.Rays() : nullptr,

@@ -26,6 +26,24 @@
 namespace leaflux {
 namespace {
 
+// A closed instance of a level, held by the instances opened beside it (ClosedNode::held).
+struct HeldClosed {
+    std::string name;
+    glm::dmat4 worldFromInstance{1.0};
+    glm::dvec3 boxMin{0.0}, boxMax{0.0};
+    double areaM2 = 0.0;
+    std::shared_ptr<const ClosedContents> contents;
+    std::vector<double> intensity;  // [bin][channel], W/sr
+};
+
+// What the instances opened in a level hold fixed from it and the levels it lies in
+// (InstancedOptions::holdOutside): their organs' and surfaces' patches as emitters, their
+// closed instances with the intensity each sent: those the level held, then its own.
+struct HeldOutside {
+    std::vector<Emitter> emitters;
+    std::vector<HeldClosed> closed;
+};
+
 // One part of the scene as a scene of its own, in the world frame, with its instances
 // closed; it lives while the parts under it are solved (their rays meet it).
 struct Level {
@@ -36,6 +54,9 @@ struct Level {
     std::vector<std::uint32_t> closedPart;  // by closed instance: its part
     std::vector<glm::dmat4> worldFromClosed;
     std::unique_ptr<Occlusion> occlusion;
+    // What it holds from further out: the emitters of `held` and, after its own
+    // `closedPart.size()` in `closed`, the closed instances of `held` but the one it is.
+    std::shared_ptr<const HeldOutside> held;
 };
 
 glm::dvec3 Centre(const glm::dvec3& lo, const glm::dvec3& hi) { return 0.5 * (lo + hi); }
@@ -76,7 +97,7 @@ class InstancedSolve {
     void Run() {
         const std::unique_ptr<Level> top = Build(InstanceTree::kTop, glm::dmat4(1.0), nullptr, 0);
         LevelSolution light = Solve(InstanceTree::kTop, *top, {});
-        HoldSurfaces(light.surfaces);
+        if (!options_.holdOutside) held_ = Emitters(light.surfaces);
         errorW_ = light.errorW;
         sourceCount_ = light.sourceCount;
         OpenInstances(*top, light);
@@ -86,7 +107,12 @@ class InstancedSolve {
     static constexpr std::uint32_t kNoReceiver = 0xFFFFFFFFu;
 
     std::unique_ptr<Level> Build(std::uint32_t p, const glm::dmat4& worldFromRoot,
-                                 const Level* outside, std::uint32_t indexOutside) const;
+                                 const Level* outside, std::uint32_t indexOutside,
+                                 std::shared_ptr<const HeldOutside> held = nullptr,
+                                 std::size_t heldSelf = 0) const;
+    // What the instances opened in `level` hold (holdOutside): what it held, and its own
+    // patches and closed instances as solved.
+    std::shared_ptr<const HeldOutside> HeldBy(const Level& level, const LevelSolution& light) const;
     LevelSolution Solve(std::uint32_t p, const Level& level,
                         std::vector<DirectionalSource> sources);
     // The scene's receiver that receiver r of a level with `organs` organ receivers is:
@@ -118,7 +144,8 @@ class InstancedSolve {
     ShadowView ShadowsOf(std::uint32_t p, const FlatScene& flat) const;
     // The light that arrived on closed instance c of `level`, as the sources of its contents.
     std::vector<DirectionalSource> ArrivedOn(const LevelSolution& light, std::size_t c) const;
-    void HoldSurfaces(const std::vector<LevelSolution::SurfacePatch>& surfaces);
+    // Each patch side that sends light, as an emitter held fixed (ReceiverKind::kHeld).
+    static std::vector<Emitter> Emitters(const std::vector<LevelSolution::SurfacePatch>& patches);
     void OpenInstances(const Level& level, const LevelSolution& light);
     // Whether part q, placed by worldFromRoot, is opened (InstancedOptions::maxDepth,
     // outputLevel, inView).
@@ -130,7 +157,8 @@ class InstancedSolve {
     void SolveWhole(const Level& level, const LevelSolution& light, std::size_t c);
     // Marks the organs of part q and of the parts in it unsolved; their count and area.
     void MarkUnsolved(std::uint32_t q, StructureLight& whole);
-    void Open(const Level& parent, std::size_t c, std::vector<DirectionalSource> sources);
+    void Open(const Level& parent, std::size_t c, std::vector<DirectionalSource> sources,
+              std::shared_ptr<const HeldOutside> held, std::size_t heldSelf);
 
     const Scene& scene_;
     const FlatScene& receivers_;
@@ -152,8 +180,9 @@ class InstancedSolve {
 };
 
 std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& worldFromRoot,
-                                             const Level* outside,
-                                             std::uint32_t indexOutside) const {
+                                             const Level* outside, std::uint32_t indexOutside,
+                                             std::shared_ptr<const HeldOutside> held,
+                                             std::size_t heldSelf) const {
     const InstanceTree::Part& part = tree_[p];
     auto level = std::make_unique<Level>();
     Scene& local = level->scene;
@@ -163,7 +192,7 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
         local.environment = scene_.environment;
         local.sources = scene_.sources;
     } else {
-        local.sources.emitters = held_;
+        local.sources.emitters = held ? held->emitters : held_;
     }
     local.nodes.reserve(part.nodes.size());
     for (std::size_t i : part.nodes) {
@@ -209,13 +238,31 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
         level->closed.push_back(std::move(closed));
         level->closedPart.push_back(q);
     }
+    // Those held from further out, after its own, but the one it is: the rays do not meet
+    // them (their levels' occlusion holds their proxies).
+    std::vector<ClosedProxy> proxies;
+    for (const ClosedNode& closed : level->closed) proxies.push_back(closed.Proxy());
+    if (held) {
+        for (std::size_t i = 0; i < held->closed.size(); ++i) {
+            if (i == heldSelf) continue;
+            const HeldClosed& from = held->closed[i];
+            ClosedNode closed;
+            closed.name = from.name;
+            closed.sceneFromInstance = sceneFromWorld * from.worldFromInstance;
+            closed.boxMin = from.boxMin;
+            closed.boxMax = from.boxMax;
+            closed.areaM2 = from.areaM2;
+            closed.contents = from.contents;
+            closed.held = from.intensity;
+            level->closed.push_back(std::move(closed));
+        }
+        level->held = std::move(held);
+    }
     // An opened part's rays meet its own organs; the surfaces it holds are seen by their
     // links alone.
     level->rays = std::make_unique<RayScene>(
         level->flat, std::nullopt, RayDevice::Shared(),
         p == InstanceTree::kTop ? kNoTriangle : OrganTriangles(level->flat));
-    std::vector<ClosedProxy> proxies;
-    for (const ClosedNode& closed : level->closed) proxies.push_back(closed.Proxy());
     OutsideView view;
     if (outside != nullptr) {
         view = {
@@ -251,6 +298,7 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     problem.sourceCount = sourceCount_;
     if (p == InstanceTree::kTop) problem.organs = &receivers_;  // ε as HRC takes it
     problem.splitSurfaces = true;  // the surfaces' light, held by the contents (Build)
+    problem.holdLevel = options_.holdOutside;
     LevelSolution light = SolveLevel(level.scene, level.flat, *level.rays, options_.hrc,
                                      level.closed, std::move(problem));
     // Its receivers' light, where the scene has them.
@@ -288,8 +336,10 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     return light;
 }
 
-void InstancedSolve::HoldSurfaces(const std::vector<LevelSolution::SurfacePatch>& surfaces) {
-    for (const LevelSolution::SurfacePatch& patch : surfaces) {
+std::vector<Emitter> InstancedSolve::Emitters(
+    const std::vector<LevelSolution::SurfacePatch>& patches) {
+    std::vector<Emitter> held;
+    for (const LevelSolution::SurfacePatch& patch : patches) {
         for (int side : {kUpper, kLower}) {
             const std::vector<double>& exitance = side == kUpper ? patch.upper : patch.lower;
             if (std::none_of(exitance.begin(), exitance.end(), [](double e) { return e > 0.0; }))
@@ -298,9 +348,37 @@ void InstancedSolve::HoldSurfaces(const std::vector<LevelSolution::SurfacePatch>
             mesh->positions = {patch.a, side == kUpper ? patch.b : patch.c,
                                side == kUpper ? patch.c : patch.b};
             mesh->triangles = {{0, 1, 2}};
-            held_.push_back({"held surface", std::move(mesh), exitance, "", true});
+            held.push_back({"held surface", std::move(mesh), exitance, "", true});
         }
     }
+    return held;
+}
+
+std::shared_ptr<const HeldOutside> InstancedSolve::HeldBy(const Level& level,
+                                                          const LevelSolution& light) const {
+    auto held = std::make_shared<HeldOutside>();
+    if (level.held) held->emitters = level.held->emitters;
+    std::vector<Emitter> own = Emitters(light.surfaces);
+    held->emitters.insert(held->emitters.end(), std::make_move_iterator(own.begin()),
+                          std::make_move_iterator(own.end()));
+    // Its closed instances where they are: those it held, then its own.
+    const glm::dmat4 worldFromScene = glm::translate(glm::dmat4(1.0), level.flat.origin);
+    const std::size_t owned = level.closedPart.size();
+    const auto hold = [&](std::size_t c) {
+        const ClosedNode& closed = level.closed[c];
+        std::vector<double> intensity = c >= owned                      ? closed.held
+                                        : light.closedIntensity.empty() ? std::vector<double>()
+                                                                        : light.closedIntensity[c];
+        // A level nothing lit hands on no intensity: its instances send nothing.
+        if (intensity.empty())
+            intensity.assign(static_cast<std::size_t>(light.bins) * scene_.bands.size(), 0.0);
+        held->closed.push_back({closed.name, worldFromScene * closed.sceneFromInstance,
+                                closed.boxMin, closed.boxMax, closed.areaM2, closed.contents,
+                                std::move(intensity)});
+    };
+    for (std::size_t c = owned; c < level.closed.size(); ++c) hold(c);
+    for (std::size_t c = 0; c < owned; ++c) hold(c);
+    return held;
 }
 
 std::vector<DirectionalSource> InstancedSolve::ArrivedOn(const LevelSolution& light,
@@ -315,8 +393,11 @@ std::vector<DirectionalSource> InstancedSolve::ArrivedOn(const LevelSolution& li
         if (source.beyond) sources.push_back(source);
     }
     // The rest, per bin: what the level's links brought, and what the cones of light that
-    // lit the level from further out brought through it.
-    std::vector<double> bins = light.arrivedBins[c];
+    // lit the level from further out brought through it. Holding the level (holdOutside),
+    // its links' light comes by links from what the contents hold instead (Build).
+    std::vector<double> bins = options_.holdOutside
+                                   ? std::vector<double>(light.arrivedBins[c].size(), 0.0)
+                                   : light.arrivedBins[c];
     for (std::size_t s = 0; s < light.sources.size(); ++s) {
         const DirectionalSource& source = light.sources[s];
         const double visibility = light.sourceVisibility[c][s];
@@ -348,18 +429,25 @@ std::vector<DirectionalSource> InstancedSolve::ArrivedOn(const LevelSolution& li
 
 void InstancedSolve::OpenInstances(const Level& level, const LevelSolution& light) {
     std::vector<std::size_t> opened;
-    for (std::size_t c = 0; c < level.closed.size(); ++c) {
+    for (std::size_t c = 0; c < level.closedPart.size(); ++c) {
         if (Opens(level.closedPart[c], level.worldFromClosed[c])) {
             opened.push_back(c);
         } else {
             SolveWhole(level, light, c);
         }
     }
+    if (opened.empty()) return;
     std::vector<std::vector<DirectionalSource>> arrived(opened.size());
     for (std::size_t i = 0; i < opened.size(); ++i) arrived[i] = ArrivedOn(light, opened[i]);
+    // What they hold of this level and those further out (holdOutside): an instance's own
+    // entry there is after those this level held.
+    const std::shared_ptr<const HeldOutside> held =
+        options_.holdOutside ? HeldBy(level, light) : nullptr;
+    const std::size_t inherited = level.closed.size() - level.closedPart.size();
     // Siblings are independent once their parent is solved: each its own problem.
-    tbb::parallel_for(std::size_t{0}, opened.size(),
-                      [&](std::size_t i) { Open(level, opened[i], std::move(arrived[i])); });
+    tbb::parallel_for(std::size_t{0}, opened.size(), [&](std::size_t i) {
+        Open(level, opened[i], std::move(arrived[i]), held, inherited + opened[i]);
+    });
 }
 
 bool InstancedSolve::HoldsInstanceOf(std::uint32_t q, NodeType type) const {
@@ -465,10 +553,12 @@ void InstancedSolve::SolveWhole(const Level& level, const LevelSolution& light, 
 }
 
 void InstancedSolve::Open(const Level& parent, std::size_t c,
-                          std::vector<DirectionalSource> sources) {
+                          std::vector<DirectionalSource> sources,
+                          std::shared_ptr<const HeldOutside> held, std::size_t heldSelf) {
     const std::uint32_t q = parent.closedPart[c];
     const std::unique_ptr<Level> level =
-        Build(q, parent.worldFromClosed[c], &parent, static_cast<std::uint32_t>(c));
+        Build(q, parent.worldFromClosed[c], &parent, static_cast<std::uint32_t>(c), std::move(held),
+              heldSelf);
     const LevelSolution light = Solve(q, *level, std::move(sources));
     OpenInstances(*level, light);
 }

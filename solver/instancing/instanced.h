@@ -13,24 +13,28 @@
 //    smaller instances closed, and solved as a scene of its own (SolveLevel) under the
 //    light that arrived on it, held fixed: the suns and sky cones, their rays meeting the
 //    whole scene outside it (OutsideView: the levels it lies in, their closed instances
-//    but it); the top's surfaces (a ground, walls, lamps), each patch as the top solved
-//    it, held (ReceiverKind::kHeld: it sends its light and receives nothing), linked to
-//    the contents as any sender is, with its parallax across them, through the whole
-//    scene's organs; and the rest, which the links from other instances and the level's
-//    organs brought per direction bin, as cones of light from the bins that meet its
-//    contents alone. Its links are refined under the top level's threshold, so that ε
-//    means the same at every depth. Its leaves' light is written as they are reached,
-//    its smaller instances opened in turn — siblings in parallel, each a problem of its
-//    own, so the answer does not depend on the number of threads — and then it is freed.
+//    but it); and everything the levels it lies in hold that sends light, as solved there
+//    and held fixed (InstancedOptions::holdOutside): the surfaces' and organs' patches
+//    (ReceiverKind::kHeld: each sends its radiosity and receives nothing) and the other
+//    closed instances, each sending the intensity it sent there (ClosedNode::held).
+//    These are linked to the contents as any sender is, with their parallax across them
+//    and, by geometry, through the whole scene's organs: the paper's copies of the links
+//    that arrived on the instance, made again from their senders. A closed instance
+//    whose bounds the contents overlap lights them from all around (HeldAroundLinks).
+//    Its links are refined under the top level's threshold, so that ε means the same at
+//    every depth. Its leaves' light is written as they are reached, its smaller
+//    instances opened in turn — siblings in parallel, each a problem of its own, so the
+//    answer does not depend on the number of threads — and then it is freed.
 //
-// The paper copies each link that arrived on the instance with its sender, and so keeps
-// its parallax across the instance. Here the surfaces' links are made again from the
-// held surfaces, which keeps it; the light from other instances is held as the
-// instance's incoming radiance per bin (34 directions at the default level), the same at
-// every point of it. Held as bins, the ground's light came down to the leaves as the
-// instance's centre sees it: on the 10,000-leaf tree the lower sides got twice what they
-// get from the ground (under the crown the ground is in its shadow). The direct light,
-// most of what leaves get, is traced from every point through the whole scene.
+// Without holdOutside, only the top's surfaces are held; what other instances and the
+// levels' organs sent arrives as the instance's incoming light per direction bin (34
+// directions at the default level), the same at every point of it: cheaper, and its
+// leaves' share of that light comes out too even. On the 10,000-leaf tree's lower sides
+// in NIR, the mean of each branch's leaves was off by up to a quarter that way. Held as
+// bins, the ground's light came down to the leaves as the instance's centre sees it: the
+// lower sides got twice what they get from the ground (under the crown the ground is in
+// its shadow). The direct light, most of what leaves get, is traced from every point
+// through the whole scene.
 #pragma once
 
 #include <cstdint>
@@ -67,6 +71,15 @@ struct InstancedOptions {
     // its box's corners): a picture opens only the instances in view (Soler 2003 §7.1,
     // leaflux render). The others are solved whole, as beyond maxDepth.
     std::function<bool(const glm::dvec3& worldMin, const glm::dvec3& worldMax)> inView;
+    // What an opened instance takes from the level it was closed in (Soler 2003 §3.4). True:
+    // that level's organs' patches (each organ's triangles as its own, the area mean of
+    // their parts), its surfaces' patches and its other closed instances, held fixed as
+    // solved there, and what that level held in turn, each linked into the contents and
+    // refined there, so that the light keeps its parallax across the instance: the
+    // paper's link copies. False: the light that arrived on the closed instance per
+    // direction bin, the same at each of its points (the top's surfaces still held);
+    // cheaper, less accurate in scattered light.
+    bool holdOutside = true;
 };
 
 struct InstancedStats {

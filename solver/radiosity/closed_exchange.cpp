@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "solver/util/box.h"
 
@@ -75,6 +76,60 @@ std::vector<NodeLink> OverlappingClosedLinks(const NodeModel& model, std::uint32
                                  static_cast<std::uint16_t>(d)};
         link.senderBins.weight = {static_cast<std::uint16_t>(BinWeights::kUnit), 0};
         link.reach = -1.0f;  // neither end can be split: it stands whatever it carries
+        link.geometricError = 1.0f;
+        links.push_back(link);
+    }
+    return links;
+}
+
+std::vector<NodeLink> HeldAroundLinks(
+    const NodeModel& model, std::uint32_t r, std::uint32_t s,
+    const std::function<double(const Hierarchy::Point&, const glm::dvec3&, double)>& passed,
+    std::int64_t& rays) {
+    const Hierarchy& hierarchy = model.Nodes();
+    const ClosedNode& sender = hierarchy.Closed()[hierarchy[s].closed];
+    const DirectionSet& directions = model.Directions();
+    const glm::dmat4 instanceFromScene = glm::inverse(sender.sceneFromInstance);
+    const glm::dmat3 linear(instanceFromScene);
+    const glm::dvec3 size = sender.boxMax - sender.boxMin;
+    const double volume =
+        size.x * size.y * size.z / std::abs(glm::determinant(linear));  // the scene's m³
+    if (!(volume > 0.0)) return {};
+    // r's points, spread over its area (in the sender's frame).
+    std::vector<Hierarchy::Point> at;
+    std::vector<glm::dvec3> points;
+    constexpr int kSide = 2;  // 4 points, a ray each per direction bin
+    for (int i = 0; i < kSide; ++i) {
+        for (int j = 0; j < kSide; ++j) {
+            at.push_back(hierarchy.Sample(r, (i + 0.5) / kSide, (j + 0.5) / kSide));
+            points.emplace_back(instanceFromScene * glm::dvec4(at.back().position, 1.0));
+        }
+    }
+    std::vector<NodeLink> links;
+    for (int d = 0; d < directions.Size(); ++d) {
+        const glm::dvec3& omega = directions.Direction(d);  // the way the light goes
+        const glm::dvec3 back = linear * -omega;            // towards where it comes from
+        double behind = 0.0;  // the mean ℓ (m), as far as seen from the point
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            const BoxSpan span = LineThroughBox(points[i], back, sender.boxMin, sender.boxMax);
+            if (!span.Meets() || span.exit <= 0.0) continue;
+            const double from = std::max(span.enter, 0.0), length = span.exit - from;
+            // Seen as far as the middle of that part.
+            ++rays;
+            behind += length * passed(at[i], -omega, from + 0.5 * length);
+        }
+        behind /= static_cast<double>(points.size());
+        if (behind <= 0.0) continue;
+        NodeLink link;
+        link.sender = s;
+        link.ownRays = true;  // its rays traced here
+        link.toSender = glm::vec3(-omega);
+        link.transfer[0] = static_cast<float>(directions.HatIntegralSr(d) * behind / volume);
+        link.receiverBins = Locate(directions, -omega);
+        link.senderBins.index = {static_cast<std::uint16_t>(d), static_cast<std::uint16_t>(d),
+                                 static_cast<std::uint16_t>(d)};
+        link.senderBins.weight = {static_cast<std::uint16_t>(BinWeights::kUnit), 0};
+        link.reach = -1.0f;  // it stands whatever it carries
         link.geometricError = 1.0f;
         links.push_back(link);
     }

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "solver/radiosity/links.h"
@@ -29,5 +30,17 @@ bool OverlappingClosed(const Hierarchy& hierarchy, std::uint32_t r, std::uint32_
 // (what else lies between), handed to r as irradiance over r's area facing them.
 std::vector<NodeLink> OverlappingClosedLinks(const NodeModel& model, std::uint32_t r,
                                              std::uint32_t s, double visibility);
+
+// The links s → r from a closed instance held from outside (ClosedNode::held) into organs r
+// whose bounds overlap its own: r lies among its leaves, and their light arrives from all
+// around, not from its centre. One link per direction bin ω of its light: a structure whose
+// intensity I(ω) leaves evenly from its box's volume V has radiance I(ω) ℓ / V along a line
+// that crosses ℓ of the box, so r's points get, normal to ω, the bin's solid angle times
+// that radiance, with ℓ the part of the box behind them (towards where the light comes
+// from), times `visibility`.
+std::vector<NodeLink> HeldAroundLinks(
+    const NodeModel& model, std::uint32_t r, std::uint32_t s,
+    const std::function<double(const Hierarchy::Point&, const glm::dvec3&, double)>& passed,
+    std::int64_t& rays);
 
 }  // namespace leaflux

@@ -11,6 +11,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "solver/raytrace/occlusion.h"
 #include "solver/scene/scene.h"
@@ -47,6 +48,13 @@ struct ClosedNode {
     double areaM2 = 0.0;                  // the structure's leaf area, one side
     NodeId parent = kNoParent;            // the scene node it hangs under, or the top of the scene
     std::shared_ptr<const ClosedContents> contents;
+    // A closed instance of a level further out, held as it was solved there (an opened
+    // instance's sibling, Soler 2003 §3.4's link copies): the intensity it sends per bin of
+    // the cluster light's set and channel, [bin][channel] in W/sr. It sends that, receives
+    // nothing, and is not in the rays' scene (its proxy is the level's that holds it).
+    std::vector<double> held;
+
+    bool Held() const { return !held.empty(); }
 
     // Its box as rays see it.
     ClosedProxy Proxy() const {

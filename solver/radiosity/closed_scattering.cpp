@@ -19,6 +19,7 @@ ClosedResponse::ClosedResponse(const NodeModel& model,
     values_.assign(closedCount * bands_ * bins_ * inputs_, 0.0);
     tbb::parallel_for(std::size_t{0}, closedCount, [&](std::size_t c) {
         const ClosedNode& closed = hierarchy.Closed()[c];
+        if (closed.Held()) return;  // it sends what it was given
         std::vector<glm::dvec3> in(inputs_), out(bins_);
         for (std::size_t d = 0; d < bins_; ++d)
             out[d] = in[d] = closed.ToInstance(directions.Direction(static_cast<int>(d)));
@@ -41,6 +42,7 @@ double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource
     const std::size_t closedCount = hierarchy.Closed().size();
     std::vector<double> change(closedCount, 0.0), largest(closedCount, 0.0);
     tbb::parallel_for(std::size_t{0}, closedCount, [&](std::size_t c) {
+        if (hierarchy.Closed()[c].Held()) return;
         const std::uint32_t n = hierarchy.NodeOfClosed(static_cast<std::int32_t>(c));
         double* out = field.intensity[model.Slot(n)];
         const double* fromBins = arrived.bins[c];
@@ -70,7 +72,7 @@ double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource
         }
         field.emitted[n] = channels.Measure(power.data());
     });
-    const double most = *std::max_element(largest.begin(), largest.end());
+    const double most = closedCount > 0 ? *std::max_element(largest.begin(), largest.end()) : 0.0;
     return most > 0.0 ? *std::max_element(change.begin(), change.end()) / most : 0.0;
 }
 

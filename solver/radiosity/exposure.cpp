@@ -18,7 +18,8 @@ Exposure::Exposure(const NodeModel& model, const RayScene& scene, int raysPerDir
     share_.assign(size * bins_, 1.0f);
     std::vector<std::uint32_t> clusters;
     for (std::uint32_t n = 0; n < size; ++n) {
-        if (!hierarchy[n].patch && !model.Planar(n)) clusters.push_back(n);
+        // A cluster held from outside a local problem receives nothing to hand down.
+        if (!hierarchy[n].patch && !model.Planar(n) && !model.Held(n)) clusters.push_back(n);
     }
     const DirectionSet& directions = model.Directions();
     const DirectionSet& coarse =

@@ -51,8 +51,11 @@ Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat, std::span<const 
     }
     // Closed instances under the scene node they hang from (or at the top).
     std::unordered_map<NodeId, std::vector<std::uint32_t>> closedOf;
-    for (std::size_t c = 0; c < closed_.size(); ++c)
-        closedOf[closed_[c].parent].push_back(AddClosed(static_cast<std::uint32_t>(c)));
+    std::vector<std::uint32_t> held;  // and those held from outside, with the held surfaces
+    for (std::size_t c = 0; c < closed_.size(); ++c) {
+        const std::uint32_t node = AddClosed(static_cast<std::uint32_t>(c));
+        (closed_[c].Held() ? held : closedOf[closed_[c].parent]).push_back(node);
+    }
     std::vector<NodeId> roots;
     for (const Node& node : scene.nodes) {
         (node.parent == kNoParent ? roots : childrenOf[node.parent]).push_back(node.id);
@@ -85,7 +88,6 @@ Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat, std::span<const 
     }
     // Surfaces held from outside a local problem in clusters of their own, so that a
     // sender is held or not.
-    std::vector<std::uint32_t> held;
     for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
         const ReceiverKind kind = flat.receivers[r].kind;
         if (kind == ReceiverKind::kHeld) {
@@ -98,7 +100,7 @@ Hierarchy::Hierarchy(const Scene& scene, const FlatScene& flat, std::span<const 
     if (const auto it = closedOf.find(kNoParent); it != closedOf.end())
         top.insert(top.end(), it->second.begin(), it->second.end());
     for (const ClosedNode& node : closed_) {
-        LEAFLUX_CHECK(node.parent == kNoParent || built.count(node.parent));
+        LEAFLUX_CHECK(node.Held() || node.parent == kNoParent || built.count(node.parent));
     }
     ofScene_ = std::move(built);
     if (top.empty()) return;

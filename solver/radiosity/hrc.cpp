@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <optional>
 
@@ -144,6 +145,7 @@ class SceneSolve {
           pushPull_(model_, traversal_, exposure_) {
         field_.Resize(hierarchy_.Size());
         field_.intensity.Assign(model_.SlotCount());
+        HoldClosed();
         links_.Resize(hierarchy_.Size());
     }
 
@@ -199,6 +201,31 @@ class SceneSolve {
         Gather<kDirections>(model_, field_, *active_, traversal_.Receivers(), gathered_);
         pushPull_.PushDown<kDirections>(*active_, gathered_, sourceLight_, leafLight_, Closed());
     }
+    // Whether it holds surfaces or closed instances from outside (a local problem's).
+    bool HoldsOutside() const {
+        return std::any_of(flat_.receivers.begin(), flat_.receivers.end(),
+                           [](const Receiver& r) { return r.kind == ReceiverKind::kHeld; }) ||
+               std::any_of(hierarchy_.Closed().begin(), hierarchy_.Closed().end(),
+                           [](const ClosedNode& c) { return c.Held(); });
+    }
+    // The closed instances held from outside send what they were given, from the start.
+    void HoldClosed() {
+        const DirectionSet& directions = model_.Directions();
+        const int bins = model_.BinCount(), count = channels_.Count();
+        for (std::size_t c = 0; c < hierarchy_.Closed().size(); ++c) {
+            const ClosedNode& closed = hierarchy_.Closed()[c];
+            if (!closed.Held()) continue;
+            LEAFLUX_CHECK_EQ(closed.held.size(), static_cast<std::size_t>(bins) * count);
+            const std::uint32_t n = hierarchy_.NodeOfClosed(static_cast<std::int32_t>(c));
+            std::copy(closed.held.begin(), closed.held.end(), field_.intensity[model_.Slot(n)]);
+            std::vector<double> power(count, 0.0);
+            for (int o = 0; o < bins; ++o) {
+                for (int k = 0; k < count; ++k)
+                    power[k] += closed.held[o * count + k] * directions.HatIntegralSr(o);
+            }
+            field_.emitted[n] = channels_.Measure(power.data());
+        }
+    }
     // Direct light first, so that links are refined on what senders will send: the sources
     // pushed down, one update and a pull-up.
     void LightFromSources() {
@@ -244,7 +271,7 @@ class SceneSolve {
         }
         if (level_.organs != nullptr && organs) return area;
         for (std::size_t n = 0; n < hierarchy_.Size(); ++n) {
-            if (hierarchy_[n].closed < 0) continue;
+            if (hierarchy_[n].closed < 0 || model_.Held(static_cast<std::uint32_t>(n))) continue;
             organs = true;
             area += model_.ProjectedArea(static_cast<std::uint32_t>(n), omega);
         }
@@ -451,9 +478,11 @@ void SceneSolve::Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock)
             }
             if (iteration == 0) {
                 leafLight_.direct = leafLight_.irradiance;
-                // Light that arrived on an opened instance from the rest of the scene was
-                // incident there already: its balance counts the suns' and sky's alone.
-                if (std::any_of(sources_.begin(), sources_.end(),
+                // Light that arrived on an opened instance from the rest of the scene, or
+                // that what it holds from there sends, was incident there already: its
+                // balance counts the suns' and sky's alone.
+                if (HoldsOutside() ||
+                    std::any_of(sources_.begin(), sources_.end(),
                                 [](const DirectionalSource& s) { return !s.incident; }))
                     leafLight_.direct = sourceLight_.incident;
             }
@@ -583,11 +612,45 @@ void SceneSolve::Arrived(LevelSolution& level) const {
         std::copy_n(closedLight_.bins[c], width, level.arrivedBins[c].begin());
         std::copy_n(closedLight_.sources[c], sources_.size(), level.sourceVisibility[c].begin());
     }
+    if (level_.holdLevel) {
+        level.closedIntensity.assign(closed, {});
+        for (std::size_t c = 0; c < closed; ++c) {
+            if (hierarchy_.Closed()[c].Held()) continue;
+            const double* sent =
+                field_
+                    .intensity[model_.Slot(hierarchy_.NodeOfClosed(static_cast<std::int32_t>(c)))];
+            level.closedIntensity[c].assign(sent, sent + width);
+        }
+    }
     if (!level_.splitSurfaces) return;
-    if (closed > 0) level.surfaceBins = SurfaceBins();
+    if (closed > 0 && !level_.holdLevel) level.surfaceBins = SurfaceBins();
+    // The organs' light by their own triangles, each the area mean of its parts: they send
+    // into the instances as they are, the instances' own organs refining what they take.
+    const int count = channels_.Count();
+    std::map<std::uint32_t, std::pair<double, std::vector<double>>> organ;
     for (std::uint32_t n : traversal_.Leaves()) {
         const HrcNode& node = hierarchy_[n];
-        if (!node.patch || model_.HoldsOrgans(n) || model_.Held(n)) continue;
+        if (!node.patch || model_.Held(n) || !model_.HoldsOrgans(n) || !level_.holdLevel) continue;
+        auto& [area, sides] = organ[node.triangle];
+        sides.resize(2 * count, 0.0);
+        area += node.areaM2;
+        for (int side : {kUpper, kLower}) {
+            const double* b = field_.radiosity(n, side);
+            for (int k = 0; k < count; ++k) sides[side * count + k] += node.areaM2 * b[k];
+        }
+    }
+    for (auto& [t, light] : organ) {
+        const Triangle& triangle = flat_.triangles[t];
+        const glm::dvec3 o = flat_.origin;
+        std::vector<double>& sides = light.second;
+        for (double& b : sides) b /= light.first;
+        level.surfaces.push_back({triangle.a + o, triangle.b + o, triangle.c + o,
+                                  std::vector<double>(sides.begin(), sides.begin() + count),
+                                  std::vector<double>(sides.begin() + count, sides.end())});
+    }
+    for (std::uint32_t n : traversal_.Leaves()) {
+        const HrcNode& node = hierarchy_[n];
+        if (!node.patch || model_.Held(n) || model_.HoldsOrgans(n)) continue;
         const glm::dvec3 o = flat_.origin;
         const double* upper = field_.radiosity(n, kUpper);
         const double* lower = field_.radiosity(n, kLower);

@@ -62,7 +62,9 @@ void NodeModel::FindOrgans() {
             organs_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kOrgan;
             held_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kHeld;
         } else if (node.closed >= 0) {
-            organs_[n] = 1;
+            const bool held = hierarchy_.Closed()[node.closed].Held();
+            organs_[n] = !held;
+            held_[n] = held;
         } else {
             held_[n] = !node.children.empty();
             for (std::uint32_t child : node.children) {

@@ -62,8 +62,8 @@ class NodeModel {
     // Whether a link into node r hands the same light to organs that may see it unevenly:
     // r is a cluster with organs under it (a closed instance is one).
     bool Shared(std::uint32_t r) const { return !hierarchy_[r].patch && organs_[r]; }
-    // n holds only surfaces held from outside a local problem (ReceiverKind::kHeld): it
-    // sends its held light and receives nothing.
+    // n holds only surfaces and closed instances held from outside a local problem
+    // (ReceiverKind::kHeld, ClosedNode::held): it sends its held light and receives nothing.
     bool Held(std::uint32_t n) const {
         const HrcNode& node = hierarchy_[n];
         return node.patch ? flat_.receivers[node.receiver].kind == ReceiverKind::kHeld

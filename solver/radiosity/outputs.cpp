@@ -152,6 +152,7 @@ std::int64_t AddClosedEscape(const NodeModel& model, const Occlusion& occlusion,
     tbb::parallel_for(std::size_t{0}, closed, [&](std::size_t c) {
         SetFlushToZero();
         const ClosedNode& node = hierarchy.Closed()[c];
+        if (node.Held()) return;  // its light is the level's that holds it
         const double* sent =
             field.intensity[model.Slot(hierarchy.NodeOfClosed(static_cast<std::int32_t>(c)))];
         const std::uint32_t self = static_cast<std::uint32_t>(c);

@@ -173,6 +173,9 @@ Refiner::Verdict::Kind Refiner::SplitChoice(std::uint32_t r, std::uint32_t s) co
     if (const std::uint32_t closed = receiverLarger ? r : s; model_.Closed(closed) != nullptr) {
         const std::uint32_t other = receiverLarger ? s : r;
         const HrcNode& cluster = hierarchy_[other];
+        // Organs among a held instance's leaves go no finer than half its radius (JudgePair).
+        if (model_.Closed(closed)->Held() && cluster.radius <= 0.5 * hierarchy_[closed].radius)
+            return Verdict::kNone;
         const bool overlapping = !cluster.patch && !model_.Planar(other) &&
                                  BoundsOverlap(cluster, hierarchy_[closed]) && CanSplit(other);
         return overlapping ? smaller : Verdict::kNone;
@@ -191,6 +194,22 @@ Refiner::Verdict Refiner::JudgePair(std::uint32_t r, std::uint32_t s) const {
         Verdict verdict;
         const double v = visibility_.Between(r, s, RaySet::kValuing, verdict.rays).visibility;
         verdict.links = OverlappingClosedLinks(model_, r, s, v);
+        if (!verdict.links.empty()) verdict.kind = Verdict::kLink;
+        return verdict;
+    }
+    // Organs among the leaves of a closed instance held from outside: split down to half
+    // its radius, then its light from all around them (HeldAroundLinks).
+    if (const ClosedNode* held = model_.Closed(s);
+        held != nullptr && held->Held() && BoundsOverlap(hierarchy_[r], hierarchy_[s])) {
+        if (hierarchy_[r].radius > 0.5 * hierarchy_[s].radius && CanSplit(r))
+            return Verdict::Of(Verdict::kSplitReceiver);
+        Verdict verdict;
+        verdict.links = HeldAroundLinks(
+            model_, r, s,
+            [&](const Hierarchy::Point& p, const glm::dvec3& direction, double length) {
+                return visibility_.HeldTransmittance(p, direction, length);
+            },
+            verdict.rays);
         if (!verdict.links.empty()) verdict.kind = Verdict::kLink;
         return verdict;
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "solver/util/box.h"
 #include "solver/util/sampling.h"
 
 namespace leaflux {
@@ -29,6 +30,15 @@ double LinkVisibility::ClosedBrightness(std::int32_t closed, const glm::dvec3& t
     const std::uint32_t n = hierarchy_.NodeOfClosed(closed);
     const double area = model_.ProjectedArea(n, -towardQ);
     return area > 0.0 ? model_.Power(field_, n, -towardQ) / area : 0.0;
+}
+
+double LinkVisibility::HeldEntry(std::int32_t closed, const glm::dvec3& from,
+                                 const glm::dvec3& direction) const {
+    const ClosedNode& node = hierarchy_.Closed()[closed];
+    const glm::dmat4 instanceFromScene = glm::inverse(node.sceneFromInstance);
+    const glm::dvec3 o(instanceFromScene * glm::dvec4(from, 1.0));
+    const glm::dvec3 d = glm::dmat3(instanceFromScene) * direction;
+    return std::max(LineThroughBox(o, d, node.boxMin, node.boxMax).enter, 0.0);
 }
 
 double LinkVisibility::HeldTransmittance(const Hierarchy::Point& p, const glm::dvec3& direction,
@@ -157,7 +167,12 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set,
         ++rays, ++traced;
         total += weight;
         totalLight += light;
-        const double through = Passed(p, q.closed, d / distance, distance * (1.0 - 1e-4), held);
+        // From a closed instance held from outside, the ray ends where it enters the box:
+        // what its own contents do to its light is in the intensity it was given.
+        double length = distance * (1.0 - 1e-4);
+        if (held && q.closed >= 0)
+            length = std::min(length, HeldEntry(q.closed, p.position, d / distance));
+        const double through = length > 0.0 ? Passed(p, q.closed, d / distance, length, held) : 1.0;
         visible += weight * through;
         visibleLight += light * through;
         passed += through;

@@ -41,6 +41,9 @@ struct Sight {
 
 class LinkVisibility {
   public:
+    // Along a ray from p towards a held surface, `length` long.
+    double HeldTransmittance(const Hierarchy::Point& p, const glm::dvec3& direction,
+                             double length) const;
     LinkVisibility(const NodeModel& model, const Field& field, const Occlusion& occlusion,
                    int visibilityRays, int sourceRays)
         : hierarchy_(model.Nodes()),
@@ -100,9 +103,10 @@ class LinkVisibility {
     // through triangles alone, else the transmittance, the ray's own ends left out.
     double Passed(const Hierarchy::Point& p, std::int32_t closedEnd, const glm::dvec3& direction,
                   double length, bool held) const;
-    // Along a ray from p towards a held surface, `length` long.
-    double HeldTransmittance(const Hierarchy::Point& p, const glm::dvec3& direction,
-                             double length) const;
+    // How far a ray from `from` along unit `direction` goes before it enters the box of
+    // held closed instance `closed` (0 from inside it).
+    double HeldEntry(std::int32_t closed, const glm::dvec3& from,
+                     const glm::dvec3& direction) const;
     // What a sender's point q sends towards the ray (from the receiver, towardQ), all
     // channels: the radiosity of a patch's side facing it, a closed instance's radiance.
     double Brightness(const Hierarchy::Point& q, const glm::dvec3& towardQ) const {
