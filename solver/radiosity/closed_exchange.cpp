@@ -98,10 +98,9 @@ std::vector<NodeLink> HeldAroundLinks(
     // r's points, spread over its area (in the sender's frame).
     std::vector<Hierarchy::Point> at;
     std::vector<glm::dvec3> points;
-    constexpr int kSide = 2;  // 4 points, a ray each per direction bin
-    for (int i = 0; i < kSide; ++i) {
-        for (int j = 0; j < kSide; ++j) {
-            at.push_back(hierarchy.Sample(r, (i + 0.5) / kSide, (j + 0.5) / kSide));
+    for (int i = 0; i < kCells; ++i) {  // a ray each per direction bin
+        for (int j = 0; j < kCells; ++j) {
+            at.push_back(hierarchy.Sample(r, (i + 0.5) / kCells, (j + 0.5) / kCells));
             points.emplace_back(instanceFromScene * glm::dvec4(at.back().position, 1.0));
         }
     }
