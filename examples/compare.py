@@ -4,10 +4,17 @@ Prints, per band, the L2 error in % of the reference maximum (Soler 2003, Fig. 1
 mean and 95th-percentile relative errors over lit leaves (5 % of the brightest or more),
 and the mean signed error of each fifth of the leaves from the darkest to the brightest
 (in % of the maximum): a solver that spreads light too evenly is high in the first fifths
-and low in the last."""
+and low in the last. With `--scene SCENE --by TYPE`, the L2 error split into the part the
+leaves of one structure share (each structure's mean error: the smallest structure of TYPE
+holding the leaf, with at least --min-leaves leaves) and the part within structures;
+their squares add up to the whole's: a solver that shares light out wrongly between
+structures, as instancing may between its instances, shows in the first."""
 import argparse
+import collections
 import csv
 import math
+import os
+import sys
 
 LIT = 0.05
 
@@ -41,17 +48,70 @@ def bias_by_fifth(reference, value, band):
     return [100 * sum(value[k] - reference[k] for k in f) / len(f) / largest for f in fifths if f]
 
 
+def structure_of_leaves(path, by, least):
+    """Leaf name -> the name of the smallest node of type `by` above it holding at least
+    `least` leaves (None where there is none)."""
+    python = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python")
+    if python not in sys.path:
+        sys.path.insert(0, python)
+    from leaflux.scene import read_scene  # noqa: E402
+    from leaflux import leaflux_pb2 as pb  # noqa: E402
+    scene = read_scene(path)
+    nodes = {n.id: n for n in scene.nodes}
+    kind = pb.NodeType.Value("NODE_TYPE_" + by.upper())
+    leaves = collections.Counter()
+    for n in scene.nodes:
+        if n.type == pb.NODE_TYPE_LEAF:
+            p = n.parent
+            while p in nodes:
+                leaves[p] += 1
+                p = nodes[p].parent
+    holder = {}
+    for n in scene.nodes:
+        if n.type != pb.NODE_TYPE_LEAF:
+            continue
+        p = n.parent
+        while p in nodes and not (nodes[p].type == kind and leaves[p] >= least):
+            p = nodes[p].parent
+        holder[n.name] = nodes[p].name if p in nodes else None
+    return holder
+
+
+def split_by_structure(reference, value, band, holder):
+    """(between, within, structures): the L2 error (% of max) of the structures' mean
+    errors and of what is left, over one band's leaves."""
+    keys = [k for k in reference if k[1] == band]
+    largest = max(reference[k] for k in keys)
+    groups = collections.defaultdict(list)
+    for k in keys:
+        groups[holder.get(k[0])].append(value[k] - reference[k])
+    total = sum(d * d for g in groups.values() for d in g)
+    between = sum(len(g) * (sum(g) / len(g)) ** 2 for g in groups.values())
+    scale = 100 / largest / math.sqrt(len(keys))
+    return scale * math.sqrt(between), scale * math.sqrt(max(total - between, 0.0)), len(groups)
+
+
 def main():
     parser = argparse.ArgumentParser(description=" ".join(__doc__.split()))
     parser.add_argument("reference", help="per-leaf CSV of the reference (leaflux solve --out)")
     parser.add_argument("other", help="per-leaf CSV of the solver compared with it")
+    parser.add_argument("--scene", help="the scene file both solved, to split the error by structure")
+    parser.add_argument("--by", default="axis", choices=["plant", "axis", "phytomer"],
+                        help="with --scene: the type of structure (default axis)")
+    parser.add_argument("--min-leaves", type=int, default=11,
+                        help="with --scene: the least leaves a structure holds (default 11, "
+                             "the default policy's smallest instance)")
     args = parser.parse_args()
     reference, value = load(args.reference), load(args.other)
+    holder = structure_of_leaves(args.scene, args.by, args.min_leaves) if args.scene else None
     for band in sorted({k[1] for k in reference}):
         l2, mean, p95 = errors(reference, value, band)
         print(f"{band}: L2 {l2:.2f} % of max, mean relative {mean:.2f} %, 95th percentile {p95:.2f} %")
         fifths = " ".join(f"{b:+.2f}" for b in bias_by_fifth(reference, value, band))
         print(f"{band}: mean signed error by fifth, darkest to brightest (% of max): {fifths}")
+        if holder is not None:
+            between, within, count = split_by_structure(reference, value, band, holder)
+            print(f"{band}: L2 between {count} structures {between:.2f} %, within them {within:.2f} %")
 
 
 if __name__ == "__main__":

@@ -29,12 +29,12 @@
 // Without holdOutside, only the top's surfaces are held; what other instances and the
 // levels' organs sent arrives as the instance's incoming light per direction bin (34
 // directions at the default level), the same at every point of it: cheaper, and its
-// leaves' share of that light comes out too even. On the 10,000-leaf tree's lower sides
-// in NIR, the mean of each branch's leaves was off by up to a quarter that way. Held as
-// bins, the ground's light came down to the leaves as the instance's centre sees it: the
-// lower sides got twice what they get from the ground (under the crown the ground is in
-// its shadow). The direct light, most of what leaves get, is traced from every point
-// through the whole scene.
+// branches share that light too evenly (the generated trees of 10,000 and 44,500 leaves:
+// NIR 2.83 and 3.72 % L2 off the reference against 2.43 and 3.25 % held, in 0.79 and 0.70
+// of the time, docs/results.md). Held as bins, the ground's light came down to the leaves
+// as the instance's centre sees it: the lower sides got twice what they get from the
+// ground (under the crown the ground is in its shadow). The direct light, most of what
+// leaves get, is traced from every point through the whole scene.
 #pragma once
 
 #include <cstdint>

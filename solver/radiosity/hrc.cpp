@@ -175,6 +175,8 @@ class SceneSolve {
     void Arrived(LevelSolution& level) const;
     // Of that, per closed instance, what the links from surfaces brought.
     std::vector<std::vector<double>> SurfaceBins() const;
+    // With LevelProblem::holdLevel: the organs' triangles as solved, into level.surfaces.
+    void HandOnOrgans(LevelSolution& level) const;
 
   private:
     void Solve(Solution& solution);
@@ -624,30 +626,7 @@ void SceneSolve::Arrived(LevelSolution& level) const {
     }
     if (!level_.splitSurfaces) return;
     if (closed > 0 && !level_.holdLevel) level.surfaceBins = SurfaceBins();
-    // The organs' light by their own triangles, each the area mean of its parts: they send
-    // into the instances as they are, the instances' own organs refining what they take.
-    const int count = channels_.Count();
-    std::map<std::uint32_t, std::pair<double, std::vector<double>>> organ;
-    for (std::uint32_t n : traversal_.Leaves()) {
-        const HrcNode& node = hierarchy_[n];
-        if (!node.patch || model_.Held(n) || !model_.HoldsOrgans(n) || !level_.holdLevel) continue;
-        auto& [area, sides] = organ[node.triangle];
-        sides.resize(2 * count, 0.0);
-        area += node.areaM2;
-        for (int side : {kUpper, kLower}) {
-            const double* b = field_.radiosity(n, side);
-            for (int k = 0; k < count; ++k) sides[side * count + k] += node.areaM2 * b[k];
-        }
-    }
-    for (auto& [t, light] : organ) {
-        const Triangle& triangle = flat_.triangles[t];
-        const glm::dvec3 o = flat_.origin;
-        std::vector<double>& sides = light.second;
-        for (double& b : sides) b /= light.first;
-        level.surfaces.push_back({triangle.a + o, triangle.b + o, triangle.c + o,
-                                  std::vector<double>(sides.begin(), sides.begin() + count),
-                                  std::vector<double>(sides.begin() + count, sides.end())});
-    }
+    if (level_.holdLevel) HandOnOrgans(level);
     for (std::uint32_t n : traversal_.Leaves()) {
         const HrcNode& node = hierarchy_[n];
         if (!node.patch || model_.Held(n) || model_.HoldsOrgans(n)) continue;
@@ -657,6 +636,33 @@ void SceneSolve::Arrived(LevelSolution& level) const {
         level.surfaces.push_back({node.a + o, node.b + o, node.c + o,
                                   std::vector<double>(upper, upper + channels_.Count()),
                                   std::vector<double>(lower, lower + channels_.Count())});
+    }
+}
+
+void SceneSolve::HandOnOrgans(LevelSolution& level) const {
+    // Each organ triangle with the area mean of its patches' radiosity: the instances it
+    // holds link it into their contents, where their own organs refine what they take.
+    const int count = channels_.Count();
+    std::map<std::uint32_t, std::pair<double, std::vector<double>>> organ;  // by triangle
+    for (std::uint32_t n : traversal_.Leaves()) {
+        const HrcNode& node = hierarchy_[n];
+        if (!node.patch || model_.Held(n) || !model_.HoldsOrgans(n)) continue;
+        auto& [area, sides] = organ[node.triangle];
+        sides.resize(2 * count, 0.0);
+        area += node.areaM2;
+        for (int side : {kUpper, kLower}) {
+            const double* b = field_.radiosity(n, side);
+            for (int k = 0; k < count; ++k) sides[side * count + k] += node.areaM2 * b[k];
+        }
+    }
+    const glm::dvec3 o = flat_.origin;
+    for (auto& [t, light] : organ) {
+        const Triangle& triangle = flat_.triangles[t];
+        std::vector<double>& sides = light.second;
+        for (double& b : sides) b /= light.first;
+        level.surfaces.push_back({triangle.a + o, triangle.b + o, triangle.c + o,
+                                  std::vector<double>(sides.begin(), sides.begin() + count),
+                                  std::vector<double>(sides.begin() + count, sides.end())});
     }
 }
 

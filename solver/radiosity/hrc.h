@@ -164,10 +164,11 @@ struct LevelProblem {
     // Whether to tell apart, of what arrived on each closed instance, the light of the
     // level's surfaces (LevelSolution::surfaceBins), and to hand them on (surfaces).
     bool splitSurfaces = false;
-    // Whether to hand on, besides the surfaces, the organs' patches and each closed
-    // instance's intensity (LevelSolution::closedIntensity), so that an opened instance can
-    // hold the whole level it was closed in (Soler 2003 §3.4: the links that arrived on it,
-    // copied with their senders held fixed) instead of taking its light per bin.
+    // Whether to hand on, besides the surfaces, the organs' triangles (each with the area
+    // mean of its patches) and each closed instance's intensity (closedIntensity), so that
+    // an opened instance can hold the whole level it was closed in (Soler 2003 §3.4: the
+    // links that arrived on it, copied with their senders held fixed) instead of taking
+    // its light per bin.
     bool holdLevel = false;
 };
 struct LevelSolution {
@@ -191,7 +192,7 @@ struct LevelSolution {
     };
     std::vector<SurfacePatch> surfaces;
     // With LevelProblem::holdLevel: per closed instance (not held), its intensity as solved,
-    // [bin][channel] in W/sr (ClosedNode::held); `surfaces` then has the organs' patches too.
+    // [bin][channel] in W/sr (ClosedNode::held); `surfaces` then has the organs' triangles too.
     std::vector<std::vector<double>> closedIntensity;
 };
 LevelSolution SolveLevel(const Scene& scene, const FlatScene& flat, const RayScene& rays,
