@@ -26,22 +26,13 @@
 namespace leaflux {
 namespace {
 
-// A closed instance of a level, held by the instances opened beside it (ClosedNode::held).
-struct HeldClosed {
-    std::string name;
-    glm::dmat4 worldFromInstance{1.0};
-    glm::dvec3 boxMin{0.0}, boxMax{0.0};
-    double areaM2 = 0.0;
-    std::shared_ptr<const ClosedContents> contents;
-    std::vector<double> intensity;  // [bin][channel], W/sr
-};
-
 // What the instances opened in a level hold fixed from it and the levels it lies in
 // (InstancedOptions::holdOutside): their organs' and surfaces' patches as emitters, their
-// closed instances with the intensity each sent: those the level held, then its own.
+// closed instances with the intensity each sent (ClosedNode::held), placed in the world
+// (sceneFromInstance: the world's frame): those the level held, then its own.
 struct HeldOutside {
     std::vector<Emitter> emitters;
-    std::vector<HeldClosed> closed;
+    std::vector<ClosedNode> closed;
 };
 
 // One part of the scene as a scene of its own, in the world frame, with its instances
@@ -245,15 +236,8 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
     if (held) {
         for (std::size_t i = 0; i < held->closed.size(); ++i) {
             if (i == heldSelf) continue;
-            const HeldClosed& from = held->closed[i];
-            ClosedNode closed;
-            closed.name = from.name;
-            closed.sceneFromInstance = sceneFromWorld * from.worldFromInstance;
-            closed.boxMin = from.boxMin;
-            closed.boxMax = from.boxMax;
-            closed.areaM2 = from.areaM2;
-            closed.contents = from.contents;
-            closed.held = from.intensity;
+            ClosedNode closed = held->closed[i];
+            closed.sceneFromInstance = sceneFromWorld * closed.sceneFromInstance;
             level->closed.push_back(std::move(closed));
         }
         level->held = std::move(held);
@@ -365,16 +349,14 @@ std::shared_ptr<const HeldOutside> InstancedSolve::HeldBy(const Level& level,
     const glm::dmat4 worldFromScene = glm::translate(glm::dmat4(1.0), level.flat.origin);
     const std::size_t owned = level.closedPart.size();
     const auto hold = [&](std::size_t c) {
-        const ClosedNode& closed = level.closed[c];
-        std::vector<double> intensity = c >= owned                      ? closed.held
-                                        : light.closedIntensity.empty() ? std::vector<double>()
-                                                                        : light.closedIntensity[c];
+        ClosedNode closed = level.closed[c];
+        closed.sceneFromInstance = worldFromScene * closed.sceneFromInstance;
+        closed.parent = kNoParent;
+        if (c < owned && !light.closedIntensity.empty()) closed.held = light.closedIntensity[c];
         // A level nothing lit hands on no intensity: its instances send nothing.
-        if (intensity.empty())
-            intensity.assign(static_cast<std::size_t>(light.bins) * scene_.bands.size(), 0.0);
-        held->closed.push_back({closed.name, worldFromScene * closed.sceneFromInstance,
-                                closed.boxMin, closed.boxMax, closed.areaM2, closed.contents,
-                                std::move(intensity)});
+        if (closed.held.empty())
+            closed.held.assign(static_cast<std::size_t>(light.bins) * scene_.bands.size(), 0.0);
+        held->closed.push_back(std::move(closed));
     };
     for (std::size_t c = owned; c < level.closed.size(); ++c) hold(c);
     for (std::size_t c = 0; c < owned; ++c) hold(c);

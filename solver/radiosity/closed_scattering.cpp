@@ -6,7 +6,23 @@
 #include <cmath>
 #include <numbers>
 
+#include "solver/util/check.h"
+
 namespace leaflux {
+namespace {
+
+// The power (W) an intensity per bin and channel ([bin][channel], W/sr) sends, per channel.
+std::vector<double> PowerSent(const DirectionSet& directions, const double* intensity, int bins,
+                              int count) {
+    std::vector<double> power(count, 0.0);
+    for (int o = 0; o < bins; ++o) {
+        for (int k = 0; k < count; ++k)
+            power[k] += intensity[o * count + k] * directions.HatIntegralSr(o);
+    }
+    return power;
+}
+
+}  // namespace
 
 ClosedResponse::ClosedResponse(const NodeModel& model,
                                const std::vector<DirectionalSource>& sources)
@@ -47,7 +63,7 @@ double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource
         double* out = field.intensity[model.Slot(n)];
         const double* fromBins = arrived.bins[c];
         const double* fromSources = arrived.sources[c];
-        std::vector<double> power(count, 0.0), sent(static_cast<std::size_t>(bins) * count);
+        std::vector<double> sent(static_cast<std::size_t>(bins) * count);
         for (int o = 0; o < bins; ++o) {
             for (int k = 0; k < count; ++k) {
                 const double* f = response.Row(c, channels.BandOf(k), o);
@@ -56,9 +72,9 @@ double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource
                 for (std::size_t s = 0; s < sources.size(); ++s)
                     intensity += fromSources[s] * sources[s].normalIrradiance[k] * f[bins + s];
                 sent[o * count + k] = intensity;
-                power[k] += intensity * directions.HatIntegralSr(o);
             }
         }
+        const std::vector<double> power = PowerSent(directions, sent.data(), bins, count);
         if (!directional) {
             for (int o = 0; o < bins; ++o) {
                 for (int k = 0; k < count; ++k)
@@ -74,6 +90,21 @@ double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource
     });
     const double most = closedCount > 0 ? *std::max_element(largest.begin(), largest.end()) : 0.0;
     return most > 0.0 ? *std::max_element(change.begin(), change.end()) / most : 0.0;
+}
+
+void HoldClosed(const NodeModel& model, Field& field) {
+    const Hierarchy& hierarchy = model.Nodes();
+    const int bins = model.BinCount(), count = model.ChannelSet().Count();
+    for (std::size_t c = 0; c < hierarchy.Closed().size(); ++c) {
+        const ClosedNode& closed = hierarchy.Closed()[c];
+        if (!closed.Held()) continue;
+        LEAFLUX_CHECK_EQ(closed.held.size(), static_cast<std::size_t>(bins) * count);
+        const std::uint32_t n = hierarchy.NodeOfClosed(static_cast<std::int32_t>(c));
+        std::copy(closed.held.begin(), closed.held.end(), field.intensity[model.Slot(n)]);
+        const std::vector<double> power =
+            PowerSent(model.Directions(), closed.held.data(), bins, count);
+        field.emitted[n] = model.ChannelSet().Measure(power.data());
+    }
 }
 
 }  // namespace leaflux

@@ -35,4 +35,8 @@ double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource
                      const ClosedResponse& response, const ClosedLight& arrived, bool directional,
                      Field& field);
 
+// Writes the intensity and emitted power of every closed instance held from outside a local
+// problem (ClosedNode::held) into the field: they send what they were given, from the start.
+void HoldClosed(const NodeModel& model, Field& field);
+
 }  // namespace leaflux

@@ -145,7 +145,7 @@ class SceneSolve {
           pushPull_(model_, traversal_, exposure_) {
         field_.Resize(hierarchy_.Size());
         field_.intensity.Assign(model_.SlotCount());
-        HoldClosed();
+        HoldClosed(model_, field_);
         links_.Resize(hierarchy_.Size());
     }
 
@@ -209,24 +209,6 @@ class SceneSolve {
                            [](const Receiver& r) { return r.kind == ReceiverKind::kHeld; }) ||
                std::any_of(hierarchy_.Closed().begin(), hierarchy_.Closed().end(),
                            [](const ClosedNode& c) { return c.Held(); });
-    }
-    // The closed instances held from outside send what they were given, from the start.
-    void HoldClosed() {
-        const DirectionSet& directions = model_.Directions();
-        const int bins = model_.BinCount(), count = channels_.Count();
-        for (std::size_t c = 0; c < hierarchy_.Closed().size(); ++c) {
-            const ClosedNode& closed = hierarchy_.Closed()[c];
-            if (!closed.Held()) continue;
-            LEAFLUX_CHECK_EQ(closed.held.size(), static_cast<std::size_t>(bins) * count);
-            const std::uint32_t n = hierarchy_.NodeOfClosed(static_cast<std::int32_t>(c));
-            std::copy(closed.held.begin(), closed.held.end(), field_.intensity[model_.Slot(n)]);
-            std::vector<double> power(count, 0.0);
-            for (int o = 0; o < bins; ++o) {
-                for (int k = 0; k < count; ++k)
-                    power[k] += closed.held[o * count + k] * directions.HatIntegralSr(o);
-            }
-            field_.emitted[n] = channels_.Measure(power.data());
-        }
     }
     // Direct light first, so that links are refined on what senders will send: the sources
     // pushed down, one update and a pull-up.
