@@ -71,7 +71,8 @@ std::vector<DirectionalSource> BeamsOf(const Scene& scene, SkyDiscretization sky
         double total = 0.0;
         for (std::size_t b = 0; b < scene.bands.size(); ++b)
             total += source.normalIrradiance[b] = irradiance[b];
-        if (total > 0.0) sources.push_back(std::move(source));
+        if (total <= 0.0) return static_cast<DirectionalSource*>(nullptr);
+        return &sources.emplace_back(std::move(source));
     };
     for (const Sun& sun : scene.sources.suns)
         add(sun.towardSun, sun.normalIrradianceWm2, std::cos(sun.angularRadiusRad));
@@ -86,7 +87,8 @@ std::vector<DirectionalSource> BeamsOf(const Scene& scene, SkyDiscretization sky
             std::vector<double> irradiance;
             for (double radiance : cone.radianceWm2Sr)
                 irradiance.push_back(radiance * cone.solidAngleSr * (1.0 + cosRadius) / 2.0);
-            add(cone.direction, irradiance, cosRadius);
+            if (DirectionalSource* added = add(cone.direction, irradiance, cosRadius))
+                added->FoldAtHorizon();
         }
     }
     return sources;

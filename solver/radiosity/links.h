@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "solver/radiosity/channels.h"
+#include "solver/radiosity/directional_source.h"
 #include "solver/radiosity/light_state.h"
 #include "solver/util/directions.h"
 
@@ -106,24 +107,6 @@ inline void ForEachSent(const NodeLink& link, const Field& field, std::uint32_t 
 struct SourceLink {
     std::uint32_t source;
     double visibility;
-};
-
-// A sun or sky cone as the hierarchy sees it: light from the directions of a circular cone
-// round `toward` (a parallel beam when cosRadius is 1). Its visibility is taken along
-// directions spread over the cone, so that a leaf is partly shadowed from a sky cone as
-// from the patch of sky it stands for; its irradiance on a plane is normalIrradiance ×
-// the cosine to `toward`, exact for a cone wholly above the plane.
-struct DirectionalSource {
-    glm::dvec3 toward;                     // unit, towards the source: the cone's axis
-    std::vector<double> normalIrradiance;  // W/m² on a plane facing `toward`, per channel
-    double cosRadius = 1.0;                // of the cone's half-angle
-    // Its rays meet what lies outside a local problem (OutsideView) as well: true for the
-    // scene's suns and sky cones; false for the light that arrived on an opened instance
-    // from the rest of the scene, whose shadows outside it that light already holds.
-    bool beyond = true;
-    // Light incident on the scene, which its energy balance counts: the suns' and sky's,
-    // not light scattered inside it.
-    bool incident = true;
 };
 
 // The links of one hierarchy, by receiver node.

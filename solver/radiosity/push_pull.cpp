@@ -167,21 +167,24 @@ void PushPull::PushSources(const Links& links, const std::vector<DirectionalSour
         const HrcNode& node = hierarchy_[n];
         for (std::size_t s = 0; s < sources.size(); ++s) {
             if (visibility[s] <= 0.0) continue;
-            const double cosine = glm::dot(node.normal, sources[s].toward);
-            const int side = cosine > 0.0 ? kUpper : kLower;
-            if (model_.Inner(node.triangle, side)) continue;
-            double* sides = out.sides(n, side);
-            double* incident = sources[s].incident ? out.incident(n, side) : nullptr;
+            double share[2] = {sources[s].SideShare(node.normal),
+                               sources[s].SideShare(-node.normal)};
+            for (int side : {kUpper, kLower}) {
+                if (model_.Inner(node.triangle, side)) share[side] = 0.0;
+            }
+            if (share[kUpper] + share[kLower] <= 0.0) continue;
             double* integral = out.integral[n];
             glm::dvec3* moment = out.moment[n];
             for (int k = 0; k < channels; ++k) {
                 const double normal = sources[s].normalIrradiance[k] * visibility[s];
-                sides[k] += normal * std::abs(cosine);
-                if (incident) incident[k] += normal * std::abs(cosine);
+                for (int side : {kUpper, kLower}) {
+                    out.sides(n, side)[k] += normal * share[side];
+                    if (sources[s].incident) out.incident(n, side)[k] += normal * share[side];
+                }
                 // A cone of radius r brings L Ω (1 + cos r) / 2 onto a plane facing it, and
                 // that times its axis is its ∫ L ω dω; its ∫ L dω is L Ω.
                 integral[k] += normal * 2.0 / (1.0 + sources[s].cosRadius);
-                moment[k] += normal * sources[s].toward;
+                moment[k] += normal * sources[s].Moment();
             }
         }
     };

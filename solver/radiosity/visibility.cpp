@@ -208,10 +208,8 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
         glm::dvec3 toward = light.toward;
         if (!beam) {
             const int cell = ShuffledStratum(i, count);
-            toward = UniformCone(light.toward, light.cosRadius,
-                                 (cell % rings + random.Uniform()) / rings,
-                                 (cell / rings + random.Uniform()) / ((count + rings - 1) / rings));
-            if (toward.z < 0.0 && light.toward.z >= 0.0) toward.z = -toward.z;
+            toward = light.Direction((cell % rings + random.Uniform()) / rings,
+                                     (cell / rings + random.Uniform()) / ((count + rings - 1) / rings));
         }
         const double weight = model_.ReceivingWeight(p.triangle, p.normal, toward);
         if (weight <= 0.0) continue;
