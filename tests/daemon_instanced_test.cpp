@@ -79,11 +79,12 @@ v1::Reply Call(Daemon& daemon, v1::Request request) {
     return daemon.Handle(request);
 }
 
-std::string Open(Daemon& daemon, const v1::Scene& scene) {
+std::string Open(Daemon& daemon, const v1::Scene& scene,
+                 const v1::SolverSettings& settings = Instanced()) {
     v1::Request request;
     v1::OpenSession* open = request.mutable_open_session();
     *open->mutable_scene() = scene;
-    *open->mutable_settings() = Instanced();
+    *open->mutable_settings() = settings;
     open->set_species(kSpecies);
     const v1::Reply reply = Call(daemon, request);
     EXPECT_TRUE(reply.has_opened()) << reply.DebugString();
@@ -107,7 +108,8 @@ v1::CycleResult RunCycle(Daemon& daemon, const std::string& session, std::int64_
 // session's settings, on `database`: organ light by node. A function is kept by its
 // signature, computed from the structure that first had it: the same scene gets the same
 // light from the same database.
-std::map<std::uint64_t, BandLight> SolvedAlone(const v1::Scene& message, PhaseDatabase& database) {
+std::map<std::uint64_t, BandLight> SolvedAlone(const v1::Scene& message, PhaseDatabase& database,
+                                               bool holdOutside = true) {
     const Scene scene = FromProto(message, "", {});
     const PreparedScene prepared(scene);
     InstancingPolicy policy = DefaultPolicy();
@@ -115,6 +117,7 @@ std::map<std::uint64_t, BandLight> SolvedAlone(const v1::Scene& message, PhaseDa
     policy.phase = {PhaseKind::kMonoDirectional, 2};
     InstancedOptions options;
     options.hrc.epsilon = 1e-3;
+    options.holdOutside = holdOutside;
     const InstancedSolution solved =
         SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), policy, database, options);
     std::map<std::uint64_t, BandLight> light;
@@ -203,6 +206,24 @@ TEST(DaemonInstanced, CyclesOfAddsRemovalsAndUpdatesGetTheLightOfASolveOfTheirSc
     // Functions come from the database: the trees' structures, met in cycle 1, are reused.
     EXPECT_GT(second.statistics().phase_functions_reused(), 0);
     EXPECT_EQ(fourthCycle.statistics().phase_db_health(), "");
+}
+
+// `per_bin`: an opened instance takes the light that arrived on it per direction bin, as
+// `leaflux solve --per-bin` does; not what the default's held level gives.
+TEST(DaemonInstanced, APerBinSessionGetsTheLightOfAPerBinSolve) {
+    Daemon daemon;
+    const v1::Scene scene = InlineProto(Trees());
+    v1::SolverSettings settings = Instanced();
+    settings.mutable_instanced()->set_per_bin(true);
+    const v1::CycleResult result = RunCycle(daemon, Open(daemon, scene, settings), 1);
+    ExpectSameLight(result, SolvedAlone(scene, daemon.PhaseFunctions(), false), 1);
+    const auto held = SolvedAlone(scene, daemon.PhaseFunctions(), true);
+    double largest = 0.0;
+    for (const v1::OrganLight& organ : result.organs()) {
+        largest = std::max(largest, std::abs(organ.bands(0).irradiance_lower_wm2() -
+                                             held.at(organ.node()).irradianceLowerWm2));
+    }
+    EXPECT_GT(largest, 1e-3);  // the field changed the solve
 }
 
 std::filesystem::path TempFile(const std::string& name) {
