@@ -6,9 +6,10 @@ the demo, and the spread of phase functions within a signature (leaflux_bench_ph
 Copies CSVs and plots to examples/report/, then writes each table from those CSVs
 between its `<!-- report:NAME -->` and `<!-- /report:NAME -->` markers, so that the docs say
 what the last run measured and nothing else: docs/results.md holds every table (one section
-per scene), README.md one summary of the error tables (`report:summary`).
+per scene), README.md one summary of the error tables (`report:summary`) and HRC's accuracy
+on the stiff scenes of tests/hrc_accuracy_test.cpp (`report:accuracy`).
 
-Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon,
+Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth,import,accuracy,stability,daemon,
                        daemon-accuracy,soak,rays,render,summary]
                       [--scenes a,b]
                       [--scaling-solvers hrc,mc,instanced,instanced-tau]
@@ -671,13 +672,75 @@ def stability_section(build, out, run=True):
     return "\n".join(table)
 
 
+def accuracy_section(build, out, run=True):
+    """HRC where users work (tests/hrc_accuracy_test.cpp): the figures each property's test
+    records (gtest's JSON output), against the goals they are held to."""
+    csv_path = os.path.join(REPORT, "hrc_accuracy.csv")
+    if run:
+        os.makedirs(out, exist_ok=True)
+        json_path = os.path.join(out, "hrc_accuracy.json")
+        subprocess.run([os.path.join(build, "tests", "leaflux_tests"), "--gtest_filter=HrcAccuracy.*",
+                        f"--gtest_output=json:{json_path}"], check=True, capture_output=True)
+        rows = []
+        for suite in json.load(open(json_path))["testsuites"]:
+            for test in suite["testsuite"]:
+                for key, value in test.items():
+                    if key not in ("name", "file", "line", "status", "result", "timestamp", "time",
+                                   "classname", "failures"):
+                        rows.append({"test": test["name"], "figure": key, "value": float(value),
+                                     "passed": "failures" not in test})
+        with open(csv_path, "w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+            writer.writeheader()
+            writer.writerows(rows)
+    values = {r["figure"]: float(r["value"]) for r in csv.DictReader(open(csv_path))}
+    failed = {r["test"] for r in csv.DictReader(open(csv_path)) if r["passed"] != "True"}
+
+    def v(key, digits=2):
+        return f"{values[key]:.{digits}f}"
+    lines = [
+        ("SkyConesAreSoftShadowsNotHardBeams",
+         "250 leaves (ρ = τ = 0.45) under the 46-cone uniform sky, per side against the continuous sky",
+         "≤ 1.5 % at ε = 1e-4",
+         f"{v('cones_hrc_1e-4_pct')} % at 1e-4, {v('cones_hrc_1e-5_pct')} % at 1e-5 "
+         f"(Monte Carlo on the cones: {v('cones_mc_pct')} %)"),
+        ("AConeAcrossALeafLightsBothItsSides",
+         "a sun of 0.2 rad across a lone leaf's plane, each side against a grid of its directions",
+         "≤ 0.01 % of the normal irradiance", f"{values['across_worst_pct_of_normal']:.1e} %"),
+        ("AGroundAroundTheCanopyDoesNotMakeItsLeavesCoarse",
+         "150 leaves on a ±10 m and a ±200 m ground, per side against Monte Carlo, ε = 1e-4",
+         "the same within noise",
+         f"{v('ground_10m_pct')} % and {v('ground_200m_pct')} %"),
+        ("AnIsotropicFieldLightsEverySideAlikeFromEveryDirection",
+         "RAMI's purist corner (ρ + τ = 1, white ±200 m ground, uniform sky): every side 100 W/m², v = 0",
+         "‖v‖ ≤ 0.05; worst side ≤ 5 % at 1e-5",
+         f"ε = 1e-4: sd {v('isotropic_1e-4_sd_pct')} %, worst {v('isotropic_1e-4_worst_pct', 1)} %, "
+         f"‖v‖ ≤ {v('isotropic_1e-4_largest_v', 3)}; 1e-5: sd {v('isotropic_1e-5_sd_pct')} %, "
+         f"worst {v('isotropic_1e-5_worst_pct', 1)} %, ‖v‖ ≤ {v('isotropic_1e-5_largest_v', 3)}"),
+        ("LightVectorsUnderSunAndSkyFollowTheReference",
+         "light vectors under a sun and a cone sky against 65,536 paths a leaf, ε = 1e-4",
+         "length within 0.05, direction within 5° where ‖v‖ > 0.2",
+         f"{v('vectors_worst_length', 3)}; {v('vectors_worst_deg', 1)}° (p95 {v('vectors_p95_deg', 1)}°)"),
+        ("ASunLightsADenseCrownAndTheGroundBeneathAsRaysThroughItFind",
+         "eight crowns of 3,000 leaves (LAI 5) under a vertical sun: the disc beneath against the gap "
+         "fraction, the leaves against the area they shade, by independent rays",
+         "≤ 0.5 % (disc), ≤ 0.2 % (leaves)",
+         f"{float(values['crown_disc_pct']):+.2f} %, {float(values['crown_leaves_pct']):+.2f} %"),
+    ]
+    table = ["| property (test `HrcAccuracy.…`) | goal | HRC |", "|---|---|---|"]
+    for test, what, goal, got in lines:
+        mark = " **failed**" if test in failed else ""
+        table.append(f"| {what} (`{test}`) | {goal} | {got}{mark} |")
+    return "\n".join(table)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("build", nargs="?", default=os.path.join(ROOT, "build", "release"),
                         help="build directory (default: build/release)")
     parser.add_argument("out", nargs="?", default=os.path.join(ROOT, "out", "report"),
                         help="directory of the runs' files (default: out/report)")
-    parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth,import,stability,daemon,daemon-accuracy,soak,rays,render",
+    parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth,import,accuracy,stability,daemon,daemon-accuracy,soak,rays,render",
                         help="parts to run (default: all)")
     parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
     parser.add_argument("--scaling-solvers", default="hrc,mc,instanced,instanced-tau",
@@ -737,6 +800,8 @@ def main():
     if "import" in parts:
         update(RESULTS, "import", import_section(build, os.path.join(out, "import"), run,
                                                  args.import_largest))
+    if "accuracy" in parts:
+        update(README, "accuracy", accuracy_section(build, os.path.join(out, "accuracy"), run))
     if "stability" in parts:
         update(RESULTS, "stability", stability_section(build, os.path.join(out, "stability"), run))
     print(f"sections {args.only} rewritten in docs/results.md"

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -50,6 +51,11 @@ Scene Canopy(int leaves, SkyDiscretization sky, double groundHalfWidthM, bool su
     }
     scene.Validate();
     return scene;
+}
+
+// A figure for the report (examples/bench_report.py, --only accuracy), in gtest's output.
+void Record(const std::string& key, double value) {
+    ::testing::Test::RecordProperty(key, std::to_string(value));
 }
 
 Solution SolveWith(const Scene& scene, SolverKind kind, double epsilon = 1e-4, int samples = 8192) {
@@ -111,6 +117,9 @@ TEST(HrcAccuracy, SkyConesAreSoftShadowsNotHardBeams) {
     // the side its axis faces: the canopy's leaves got 1.1 % too little direct light, and
     // HRC stood at 1.61 and 1.47 % (AConeAcrossALeafLightsBothItsSides). The cones add
     // nothing to HRC's error: what is left is HRC's at that ε, whatever the sky.
+    Record("cones_mc_pct", 100 * mc);
+    Record("cones_hrc_1e-4_pct", 100 * coarse);
+    Record("cones_hrc_1e-5_pct", 100 * fine);
     EXPECT_LT(coarse, 0.015);
     EXPECT_LT(coarse, 1.1 * sky);
     EXPECT_LT(fine, 0.75 * coarse);
@@ -126,6 +135,7 @@ TEST(HrcAccuracy, AConeAcrossALeafLightsBothItsSides) {
     const glm::dvec3 axis = testing::SunAt(60.0, 0.0, 1.0).towardSun;
     glm::dvec3 t, b;
     Basis(axis, t, b);
+    double worst = 0.0;
     for (double degrees : {0.0, 80.0, 85.0, 90.0, 95.0, 100.0, 180.0}) {
         const double beta = glm::radians(degrees);
         const glm::dvec3 n = std::cos(beta) * axis + std::sin(beta) * t;
@@ -154,9 +164,12 @@ TEST(HrcAccuracy, AConeAcrossALeafLightsBothItsSides) {
         std::printf("normal at %5.1f° from the sun: upper %8.3f (grid %8.3f), lower %8.3f (grid "
                     "%8.3f) W/m²\n",
                     degrees, light.irradianceUpperWm2, upper, light.irradianceLowerWm2, lower);
+        worst = std::max({worst, std::abs(light.irradianceUpperWm2 - upper),
+                          std::abs(light.irradianceLowerWm2 - lower)});
         EXPECT_NEAR(light.irradianceUpperWm2, upper, 1e-4 * e);
         EXPECT_NEAR(light.irradianceLowerWm2, lower, 1e-4 * e);
     }
+    Record("across_worst_pct_of_normal", 100 * worst / e);
 }
 
 TEST(HrcAccuracy, AGroundAroundTheCanopyDoesNotMakeItsLeavesCoarse) {
@@ -173,6 +186,8 @@ TEST(HrcAccuracy, AGroundAroundTheCanopyDoesNotMakeItsLeavesCoarse) {
     }
     std::printf("per side at ε = 1e-4: %.2f %% on a ±10 m ground, %.2f %% on a ±200 m one\n",
                 100 * errors[0], 100 * errors[1]);
+    Record("ground_10m_pct", 100 * errors[0]);
+    Record("ground_200m_pct", 100 * errors[1]);
     EXPECT_LT(errors[1], 1.5 * errors[0]);
     EXPECT_LT(errors[1], 0.05);
 }
@@ -234,6 +249,12 @@ TEST(HrcAccuracy, AnIsotropicFieldLightsEverySideAlikeFromEveryDirection) {
         EXPECT_NEAR(hrc.mean, 100.0, 1.0);
         EXPECT_LE(hrc.largest, 0.05);
     }
+    Record("isotropic_1e-4_sd_pct", 100 * coarse.sd);
+    Record("isotropic_1e-4_worst_pct", 100 * coarse.worst);
+    Record("isotropic_1e-4_largest_v", coarse.largest);
+    Record("isotropic_1e-5_sd_pct", 100 * fine.sd);
+    Record("isotropic_1e-5_worst_pct", 100 * fine.worst);
+    Record("isotropic_1e-5_largest_v", fine.largest);
     EXPECT_LE(fine.worst, 0.05);
     EXPECT_LE(fine.sd, std::cbrt(0.1) * coarse.sd);
     EXPECT_LE(fine.worst, std::cbrt(0.1) * coarse.worst);
@@ -272,6 +293,9 @@ TEST(HrcAccuracy, LightVectorsUnderSunAndSkyFollowTheReference) {
         "light vectors: |v| off by %.3f mean, %.3f worst; direction (%zu leaves with |v| > "
         "0.2) median %.2f°, p95 %.2f°, worst %.2f°\n",
         sumLength / leaves, worstLength, angles.size(), angles[angles.size() / 2], p95, worstAngle);
+    Record("vectors_worst_length", worstLength);
+    Record("vectors_p95_deg", p95);
+    Record("vectors_worst_deg", worstAngle);
     EXPECT_LE(worstLength, 0.05);
     EXPECT_LE(worstAngle, 5.0);
 }
@@ -375,6 +399,8 @@ TEST(HrcAccuracy, ASunLightsADenseCrownAndTheGroundBeneathAsRaysThroughItFind) {
     }
     std::printf("mean over %d crowns: disc %+.2f %%, leaves %+.2f %%\n", crowns,
                 100 * discSum / crowns, 100 * leavesSum / crowns);
+    Record("crown_disc_pct", 100 * discSum / crowns);
+    Record("crown_leaves_pct", 100 * leavesSum / crowns);
     EXPECT_LE(std::abs(discSum / crowns), 0.005);
     EXPECT_LE(std::abs(leavesSum / crowns), 0.002);
 }
