@@ -24,7 +24,7 @@ struct DirectionalSource {
     // A sky cone reaching below the horizon has that part folded back above it, as the
     // reference takes it (FoldAtHorizon): its directions then, 8 × 8 of equal solid angle,
     // mirrored where below, and their mean.
-    std::vector<glm::dvec3> folded;
+    std::vector<glm::dvec3> folded{};
     glm::dvec3 foldedMean{0.0};
 
     bool Folded() const { return !folded.empty(); }

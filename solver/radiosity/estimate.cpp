@@ -60,6 +60,19 @@ SidedFormFactor Estimator::PlanesForm(std::uint32_t r, std::uint32_t s, Points r
     return form;
 }
 
+// The inner side of a solid's face sees only the solid's inside: what lies beyond it is
+// hidden by the solid, and the visibility rays, which weigh that side zero, would not take
+// it off. Kept, the 10k tree's exact links handed 1.1 W onto its stems' inner sides, and
+// links from a leaf's two triangles (a flat cluster) lit a tube's inside
+// (HrcStem.LeavesAroundATubeDoNotLightItsInside).
+void Estimator::HideInnerSides(const HrcNode& R, SidedFormFactor& form) const {
+    if (!R.patch) return;  // a flat cluster has no inner side (NodeModel::Planar)
+    const double unhidden = form.upper + form.lower;
+    if (model_.Inner(R.triangle, kUpper)) form.upper = 0.0;
+    if (model_.Inner(R.triangle, kLower)) form.lower = 0.0;
+    if (unhidden > 0.0) form.solidAngleSr *= (form.upper + form.lower) / unhidden;
+}
+
 glm::dvec3 Estimator::Arrival(std::uint32_t r, std::uint32_t s) const {
     const glm::dvec3& x = hierarchy_[r].centroid;
     glm::dvec3 moment(0.0);
@@ -88,6 +101,7 @@ Estimate Estimator::Pair(std::uint32_t r, std::uint32_t s, Points rule) const {
             std::min(1.0, std::pow((R.radius + S.radius) / std::max(d, 1e-300), 2.0));
         if (model_.Planar(r)) {
             e.form = PlanesForm(r, s, rule);
+            HideInnerSides(R, e.form);
             e.sided = true;
             // Near, any part of R may see S whole; but no more than S sends from a side.
             e.reach = std::min((R.radius > 0.5 * d ? 1.0 : e.form.upper + e.form.lower) * R.areaM2,
@@ -210,14 +224,7 @@ Estimate Estimator::Exact(std::uint32_t r, std::uint32_t s, Points rule) const {
         e.form.upper = upper ? form : 0.0;
         e.form.lower = upper ? 0.0 : form;
     }
-    // The inner side of a solid's face sees only the solid's inside: what lies beyond it
-    // is hidden by the solid, and the visibility rays, which weigh that side zero, would
-    // not take it off. Kept, the 10k tree's exact links handed 1.1 W onto its stems'
-    // inner sides.
-    const double unhidden = e.form.upper + e.form.lower;
-    if (model_.Inner(R.triangle, kUpper)) e.form.upper = 0.0;
-    if (model_.Inner(R.triangle, kLower)) e.form.lower = 0.0;
-    if (unhidden > 0.0) e.form.solidAngleSr *= (e.form.upper + e.form.lower) / unhidden;
+    HideInnerSides(R, e.form);
     const double d = std::max(glm::length(S.centroid - R.centroid), 1e-300);
     // The form factor at R's centroid speaks for all of R only when R is small against
     // the distance; otherwise parts of R may see S fully (F up to 1 on each side).

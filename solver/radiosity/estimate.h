@@ -63,6 +63,8 @@ class Estimator {
 
   private:
     SidedFormFactor PlanesForm(std::uint32_t r, std::uint32_t s, Points rule) const;
+    // Takes off what `form` hands the inner side of a solid's face R (an internode's).
+    void HideInnerSides(const HrcNode& R, SidedFormFactor& form) const;
     // R's area facing the light of a sender, for the error estimate.
     double ExposedArea(std::uint32_t r, double projected, double geometricError) const {
         return projected + geometricError * std::max(hierarchy_[r].areaM2 - projected, 0.0);

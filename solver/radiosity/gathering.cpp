@@ -67,7 +67,12 @@ void Gather(const NodeModel& model, const Field& field, const Links& links,
                 const double geometric = transfer[0];
                 const std::uint32_t slot = model.Slot(link.sender);
                 if (plane) {
+                    // Towards the sender's centre; a side facing into its own solid (an
+                    // internode's inner side) gets nothing, as a patch's links give it
+                    // (Estimator::Pair).
                     const double cosine = glm::dot(R.normal, toSender);
+                    if (R.patch && model.Inner(R.triangle, cosine > 0.0 ? kUpper : kLower))
+                        continue;
                     double* side = cosine > 0.0 ? upper : lower;
                     ForEachSent(link, field, slot, channels, [&](int k, double sent) {
                         const double normal = sent * geometric;  // W/m² facing the sender
