@@ -62,7 +62,7 @@ class InstancedSolve {
           shadows_(shadows),
           tree_(tree),
           originals_(originals),
-          options_(options),
+          options_(DirectOnlyAlone(options)),
           out_(out),
           directions_(DirectionSet::OfLevel(options.hrc.directionLevel)) {
         for (std::uint32_t r = 0; r < receivers.receivers.size(); ++r) {
@@ -88,7 +88,7 @@ class InstancedSolve {
     void Run() {
         const std::unique_ptr<Level> top = Build(InstanceTree::kTop, glm::dmat4(1.0), nullptr, 0);
         LevelSolution light = Solve(InstanceTree::kTop, *top, {});
-        if (!options_.holdOutside) held_ = Emitters(light.surfaces);
+        if (!options_.holdOutside && !options_.hrc.directOnly) held_ = Emitters(light.surfaces);
         errorW_ = light.errorW;
         sourceCount_ = light.sourceCount;
         OpenInstances(*top, light);
@@ -96,6 +96,13 @@ class InstancedSolve {
 
   private:
     static constexpr std::uint32_t kNoReceiver = 0xFFFFFFFFu;
+
+    // Direct light alone: an opened instance takes the suns and sky alone, not what the
+    // levels it lies in scattered (held, or per bin).
+    static InstancedOptions DirectOnlyAlone(InstancedOptions options) {
+        if (options.hrc.directOnly) options.holdOutside = false;
+        return options;
+    }
 
     std::unique_ptr<Level> Build(std::uint32_t p, const glm::dmat4& worldFromRoot,
                                  const Level* outside, std::uint32_t indexOutside,
@@ -156,7 +163,7 @@ class InstancedSolve {
     const RayScene* const shadows_;
     const InstanceTree& tree_;
     const SceneOriginals& originals_;
-    const InstancedOptions& options_;
+    const InstancedOptions options_;  // directOnly: holdOutside off (DirectOnlyAlone)
     InstancedSolution& out_;
     const DirectionSet& directions_;
     std::unordered_map<NodeId, std::uint32_t> organReceiver_;
@@ -374,6 +381,7 @@ std::vector<DirectionalSource> InstancedSolve::ArrivedOn(const LevelSolution& li
     for (const DirectionalSource& source : light.sources) {
         if (source.beyond) sources.push_back(source);
     }
+    if (options_.hrc.directOnly) return sources;
     // The rest, per bin: what the level's links brought, and what the cones of light that
     // lit the level from further out brought through it. Holding the level (holdOutside),
     // its links' light comes by links from what the contents hold instead (Build).

@@ -107,4 +107,15 @@ void HoldClosed(const NodeModel& model, Field& field) {
     }
 }
 
+void DarkenClosed(const NodeModel& model, Field& field) {
+    const Hierarchy& hierarchy = model.Nodes();
+    const int width = model.BinCount() * model.ChannelSet().Count();
+    for (std::size_t c = 0; c < hierarchy.Closed().size(); ++c) {
+        if (hierarchy.Closed()[c].Held()) continue;
+        const std::uint32_t n = hierarchy.NodeOfClosed(static_cast<std::int32_t>(c));
+        std::fill_n(field.intensity[model.Slot(n)], width, 0.0);
+        field.emitted[n] = 0.0;
+    }
+}
+
 }  // namespace leaflux

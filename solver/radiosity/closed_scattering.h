@@ -39,4 +39,8 @@ double ScatterClosed(const NodeModel& model, const std::vector<DirectionalSource
 // problem (ClosedNode::held) into the field: they send what they were given, from the start.
 void HoldClosed(const NodeModel& model, Field& field);
 
+// Sets the intensity and emitted power of every closed instance that scatters (not held)
+// to nothing: the field before any light arrived.
+void DarkenClosed(const NodeModel& model, Field& field);
+
 }  // namespace leaflux

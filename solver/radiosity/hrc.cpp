@@ -436,6 +436,11 @@ void SceneSolve::Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock)
         field_.radiosity.ClearRow(n);
         std::copy_n(leafLight_.emission[n], channels_.Count(), field_.radiosity(n, kUpper));
     }
+    // A closed instance sends only what it scatters (its light is not pulled up from
+    // parts): dark too, or the first sweep's light, the level's incident light in its
+    // energy balance, would hold what it scattered of the light from the sources. At the
+    // top of the 10,000-leaf tree, instanced, the incident NIR was 2.7 % over HRC's.
+    DarkenClosed(model_, field_);
     pushPull_.PullUp(field_);
     double residual = 0.0;
     int iteration = 0;
