@@ -623,30 +623,36 @@ STABILITY = [
 ]
 
 
+def gtest_records(build, out, pattern, name):
+    """Runs the tests `pattern` selects and yields each test's record in gtest's JSON output
+    (its name, failures and the properties it recorded), kept as OUT/NAME.json."""
+    os.makedirs(out, exist_ok=True)
+    json_path = os.path.join(out, f"{name}.json")
+    subprocess.run([os.path.join(build, "tests", "leaflux_tests"), f"--gtest_filter={pattern}",
+                    f"--gtest_output=json:{json_path}"], check=True, capture_output=True)
+    for suite in json.load(open(json_path))["testsuites"]:
+        yield from suite["testsuite"]
+
+
 def stability_section(build, out, run=True):
     """The stability suite (tests/stability_test.cpp) for every solver: the sweeps,
     extrapolation jumps and energy balance each run records (gtest's JSON output)."""
     csv_path = os.path.join(REPORT, "stability.csv")
     if run:
-        os.makedirs(out, exist_ok=True)
-        json_path = os.path.join(out, "stability.json")
-        subprocess.run([os.path.join(build, "tests", "leaflux_tests"), "--gtest_filter=*Stability*",
-                        f"--gtest_output=json:{json_path}"], check=True, capture_output=True)
         rows = []
-        for suite in json.load(open(json_path))["testsuites"]:
-            for test in suite["testsuite"]:
-                if "balance_residual" not in test:
-                    continue
-                name, solver = test["name"].split("/")
-                scatter = ""
-                if "_scatter" in solver:
-                    solver, scatter = solver.split("_scatter")
-                    scatter = f"{float('0.' + scatter):g}"
-                rows.append({"test": name, "solver": solver, "scatter": scatter,
-                             "iterations": test["iterations"], "extrapolations": test["extrapolations"],
-                             "balance_pct": 100 * float(test["balance_residual"]),
-                             "balance_stderr_pct": 100 * float(test["balance_stderr"]),
-                             "passed": "failures" not in test})
+        for test in gtest_records(build, out, "*Stability*", "stability"):
+            if "balance_residual" not in test:
+                continue
+            name, solver = test["name"].split("/")
+            scatter = ""
+            if "_scatter" in solver:
+                solver, scatter = solver.split("_scatter")
+                scatter = f"{float('0.' + scatter):g}"
+            rows.append({"test": name, "solver": solver, "scatter": scatter,
+                         "iterations": test["iterations"], "extrapolations": test["extrapolations"],
+                         "balance_pct": 100 * float(test["balance_residual"]),
+                         "balance_stderr_pct": 100 * float(test["balance_stderr"]),
+                         "passed": "failures" not in test})
         with open(csv_path, "w", newline="") as f:
             writer = csv.DictWriter(f, fieldnames=list(rows[0]))
             writer.writeheader()
@@ -677,18 +683,13 @@ def accuracy_section(build, out, run=True):
     records (gtest's JSON output), against the goals they are held to."""
     csv_path = os.path.join(REPORT, "hrc_accuracy.csv")
     if run:
-        os.makedirs(out, exist_ok=True)
-        json_path = os.path.join(out, "hrc_accuracy.json")
-        subprocess.run([os.path.join(build, "tests", "leaflux_tests"), "--gtest_filter=HrcAccuracy.*",
-                        f"--gtest_output=json:{json_path}"], check=True, capture_output=True)
         rows = []
-        for suite in json.load(open(json_path))["testsuites"]:
-            for test in suite["testsuite"]:
-                for key, value in test.items():
-                    if key not in ("name", "file", "line", "status", "result", "timestamp", "time",
-                                   "classname", "failures"):
-                        rows.append({"test": test["name"], "figure": key, "value": float(value),
-                                     "passed": "failures" not in test})
+        for test in gtest_records(build, out, "HrcAccuracy.*", "hrc_accuracy"):
+            for key, value in test.items():
+                if key not in ("name", "file", "line", "status", "result", "timestamp", "time",
+                               "classname", "failures"):
+                    rows.append({"test": test["name"], "figure": key, "value": float(value),
+                                 "passed": "failures" not in test})
         with open(csv_path, "w", newline="") as f:
             writer = csv.DictWriter(f, fieldnames=list(rows[0]))
             writer.writeheader()
