@@ -141,8 +141,8 @@ TEST(HrcAccuracy, AConeAcrossALeafLightsBothItsSides) {
         const glm::dvec3 n = std::cos(beta) * axis + std::sin(beta) * t;
         const glm::dvec3 u = 0.05 * b, v = 0.05 * glm::cross(n, b);
         Scene scene = testing::OneBandScene({{"leaf", testing::Leaf(0.0, 0.0)}});
-        scene.nodes.push_back(testing::OrganNode(
-            1, "leaf", testing::Quad(-u - v, u - v, u + v, -u + v), "leaf"));
+        scene.nodes.push_back(
+            testing::OrganNode(1, "leaf", testing::Quad(-u - v, u - v, u + v, -u + v), "leaf"));
         Sun sun = testing::SunAt(60.0, 0.0, e);
         sun.angularRadiusRad = radius;
         scene.sources.suns.push_back(sun);
@@ -155,15 +155,15 @@ TEST(HrcAccuracy, AConeAcrossALeafLightsBothItsSides) {
         double upper = 0.0, lower = 0.0;
         for (int i = 0; i < n1; ++i) {
             for (int j = 0; j < n1; ++j) {
-                const glm::dvec3 w =
-                    UniformCone(axis, cosR, (i + 0.5) / n1, (j + 0.5) / n1);
+                const glm::dvec3 w = UniformCone(axis, cosR, (i + 0.5) / n1, (j + 0.5) / n1);
                 const double c = glm::dot(n, w) * radiance * ring * 2.0 * testing::kPi / n1;
                 (c > 0.0 ? upper : lower) += std::abs(c);
             }
         }
-        std::printf("normal at %5.1f° from the sun: upper %8.3f (grid %8.3f), lower %8.3f (grid "
-                    "%8.3f) W/m²\n",
-                    degrees, light.irradianceUpperWm2, upper, light.irradianceLowerWm2, lower);
+        std::printf(
+            "normal at %5.1f° from the sun: upper %8.3f (grid %8.3f), lower %8.3f (grid "
+            "%8.3f) W/m²\n",
+            degrees, light.irradianceUpperWm2, upper, light.irradianceLowerWm2, lower);
         worst = std::max({worst, std::abs(light.irradianceUpperWm2 - upper),
                           std::abs(light.irradianceLowerWm2 - lower)});
         EXPECT_NEAR(light.irradianceUpperWm2, upper, 1e-4 * e);
@@ -231,14 +231,13 @@ TEST(HrcAccuracy, AnIsotropicFieldLightsEverySideAlikeFromEveryDirection) {
             largest = std::max(largest, glm::length(b.LightVector()));
         }
         const double mean = sum / (2 * leaves);
-        return Spread{mean, std::sqrt(squares / (2 * leaves) - mean * mean) / mean, worst,
-                      largest};
+        return Spread{mean, std::sqrt(squares / (2 * leaves) - mean * mean) / mean, worst, largest};
     };
     const Spread mc = spread(SolveWith(scene, SolverKind::kMonteCarlo, 0.0, 4096), true);
     const Spread coarse = spread(SolveWith(scene, SolverKind::kHrc, 1e-4), false);
     const Spread fine = spread(SolveWith(scene, SolverKind::kHrc, 1e-5), false);
-    for (const auto& [name, s] : {std::pair{"mc", mc}, std::pair{"hrc 1e-4", coarse},
-                                  std::pair{"hrc 1e-5", fine}}) {
+    for (const auto& [name, s] :
+         {std::pair{"mc", mc}, std::pair{"hrc 1e-4", coarse}, std::pair{"hrc 1e-5", fine}}) {
         std::printf("%-8s: mean side %.3f W/m², sd %.2f %%, worst %.2f %%, largest |v| %.3f\n",
                     name, s.mean, 100 * s.sd, 100 * s.worst, s.largest);
     }

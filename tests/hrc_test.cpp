@@ -129,10 +129,9 @@ TEST(HrcStem, LeavesAroundATubeDoNotLightItsInside) {
         glm::dvec3 t, b;
         Basis(n, t, b);
         t *= 0.04, b *= 0.04;
-        scene.nodes.push_back(OrganNode(static_cast<NodeId>(10 + i), "leaf" + std::to_string(i),
-                                        Quad(centre - t - b, centre + t - b, centre + t + b,
-                                             centre - t + b),
-                                        "leaf"));
+        scene.nodes.push_back(OrganNode(
+            static_cast<NodeId>(10 + i), "leaf" + std::to_string(i),
+            Quad(centre - t - b, centre + t - b, centre + t + b, centre - t + b), "leaf"));
     }
     scene.sources.suns.push_back(SunAt(40, 120, 1000));
     scene.Validate();

@@ -161,8 +161,8 @@ TEST(Instanced, DirectLightAloneIsHrcsWhateverTheInstances) {
     PhaseDatabase database({});
     InstancedOptions options;
     options.hrc = settings.hrc;
-    const InstancedSolution instanced =
-        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), DefaultPolicy(), database, options);
+    const InstancedSolution instanced = SolveInstanced(scene, prepared.Flat(), &prepared.Rays(),
+                                                       DefaultPolicy(), database, options);
     ASSERT_GT(instanced.stats.depths.size(), 2u);  // axes within axes
     const auto accuracy = CompareLeaves(scene, prepared.Flat(), hrc, instanced.solution);
     std::printf("direct light, instanced against HRC: L2 %.3f / %.3f %% (PAR / NIR)\n",

@@ -20,8 +20,8 @@ double CapShare(double cosine, double cosRadius) {
     const double x = cosRadius / std::sqrt(sin2);  // cot r
     const double y = -x * cosine / sine;
     const double arc = sine * std::sqrt(std::max(0.0, 1.0 - y * y));
-    const double lit = (cosine * std::acos(std::clamp(y, -1.0, 1.0)) - x * arc) * sin2 +
-                       std::atan(arc / x);
+    const double lit =
+        (cosine * std::acos(std::clamp(y, -1.0, 1.0)) - x * arc) * sin2 + std::atan(arc / x);
     return std::max(lit, 0.0) / (std::numbers::pi * sin2);
 }
 
@@ -35,8 +35,8 @@ void DirectionalSource::FoldAtHorizon() {
     if (toward.z >= std::sqrt(1.0 - cosRadius * cosRadius)) return;
     for (int i = 0; i < kFoldedSide; ++i) {
         for (int j = 0; j < kFoldedSide; ++j) {
-            glm::dvec3 w = UniformCone(toward, cosRadius, (i + 0.5) / kFoldedSide,
-                                       (j + 0.5) / kFoldedSide);
+            glm::dvec3 w =
+                UniformCone(toward, cosRadius, (i + 0.5) / kFoldedSide, (j + 0.5) / kFoldedSide);
             w.z = std::abs(w.z);
             folded.push_back(w);
             foldedMean += w;

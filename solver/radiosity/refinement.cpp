@@ -122,8 +122,9 @@ Refiner::Verdict Refiner::JudgeSource(std::uint32_t r, std::uint32_t s) const {
     const double power = model_.ChannelSet().Measure(source.normalIrradiance.data());
     const glm::dvec3& n = hierarchy_[r].normal;
     const double unoccluded =
-        power * (model_.Planar(r) ? hierarchy_[r].areaM2 * (source.SideShare(n) + source.SideShare(-n))
-                                  : model_.ProjectedArea(r, source.toward));
+        power * (model_.Planar(r)
+                     ? hierarchy_[r].areaM2 * (source.SideShare(n) + source.SideShare(-n))
+                     : model_.ProjectedArea(r, source.toward));
     if (unoccluded <= 0.0) return {};
     // The spread is least when every ray agrees: beyond ε even then, no ray can save
     // the link, and none is traced.

@@ -208,8 +208,9 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
         glm::dvec3 toward = light.toward;
         if (!beam) {
             const int cell = ShuffledStratum(i, count);
-            toward = light.Direction((cell % rings + random.Uniform()) / rings,
-                                     (cell / rings + random.Uniform()) / ((count + rings - 1) / rings));
+            toward =
+                light.Direction((cell % rings + random.Uniform()) / rings,
+                                (cell / rings + random.Uniform()) / ((count + rings - 1) / rings));
         }
         const double weight = model_.ReceivingWeight(p.triangle, p.normal, toward);
         if (weight <= 0.0) continue;
