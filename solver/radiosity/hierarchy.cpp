@@ -1,6 +1,7 @@
 #include "solver/radiosity/hierarchy.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <unordered_map>
@@ -361,10 +362,14 @@ void Hierarchy::Truncate(std::size_t size) {
 }
 
 Hierarchy::Point Hierarchy::SampleClosed(std::int32_t closed, double u, double v) const {
-    // A point of the box from two numbers: the third coordinate from the digits of the first
-    // two that their own coordinates do not resolve.
+    // A point of the box from two numbers: the third coordinate hashed from their bits, as
+    // random as they are and unrelated to them. A linear mix of u and v would be the same for
+    // every point of a lattice (RankOneLattice: 4096 u + 64 v modulo 1 is, for 32 points),
+    // and put them all in one plane of the box.
     const ClosedNode& node = closed_[closed];
-    const double w = std::fmod(4096.0 * u + 64.0 * v, 1.0);
+    const std::uint64_t bits =
+        MixBits(std::bit_cast<std::uint64_t>(u) ^ std::rotl(std::bit_cast<std::uint64_t>(v), 32));
+    const double w = static_cast<double>(bits >> 11) * 0x1.0p-53;
     const glm::dvec3 local = node.boxMin + glm::dvec3(u, v, w) * (node.boxMax - node.boxMin);
     return {glm::dvec3(node.sceneFromInstance * glm::dvec4(local, 1.0)), glm::dvec3(0.0),
             kNoTriangle, closed};

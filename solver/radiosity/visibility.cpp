@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "solver/util/box.h"
+#include "solver/util/lattice.h"
 #include "solver/util/sampling.h"
 
 namespace leaflux {
@@ -22,6 +23,23 @@ struct Exclusion {
         }
     }
     operator std::span<const std::uint32_t>() const { return {ids, count}; }
+};
+
+// Where a link's rays start and end: the points of one rank-1 lattice, shifted apart for
+// each end, the sender's taken in the order of its strata (RandomStrata) so that no point
+// of one end is always paired with the same point of the other.
+class EndPoints {
+  public:
+    EndPoints(Random& random, int count)
+        : lattice_(RankOneLattice::Of(count)),
+          receiver_(random.Uniform(), random.Uniform()),
+          sender_(random.Uniform(), random.Uniform()) {}
+    glm::dvec2 Receiver(int i) const { return lattice_.Point(i, receiver_); }
+    glm::dvec2 Sender(int i) const { return lattice_.Point(i, sender_); }
+
+  private:
+    const RankOneLattice& lattice_;
+    const glm::dvec2 receiver_, sender_;
 };
 }  // namespace
 
@@ -84,12 +102,13 @@ Sight LinkVisibility::BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet se
     RandomStrata(random, strata, count);
     const HrcNode& S = hierarchy_[s];
     const bool held = model_.Held(s);
+    const EndPoints ends(random, count);
     double seen = 0.0, total = 0.0, passed = 0.0;
     int traced = 0;
     for (int i = 0; i < count; ++i) {
-        const Hierarchy::Point p =
-            hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
-        const double u = (strata[i] + random.Uniform()) / count, v = random.Uniform();
+        const glm::dvec2 at = ends.Receiver(i);
+        const Hierarchy::Point p = hierarchy_.Sample(r, at.x, at.y);
+        const auto [u, v] = ends.Sender(strata[i]);
         // Each ray weighted by its estimate of π F(x → S): where S is near (its radius
         // more than kNear of its distance), Ω |n · ω| for a direction uniform in S's solid
         // angle Ω; farther, A_S |n · ω| |cos θy| / d² to a point uniform on S, that kernel
@@ -149,12 +168,12 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set,
     double visible = 0.0, total = 0.0, visibleLight = 0.0, totalLight = 0.0;
     int traced = 0;
     double passed = 0.0;
+    const EndPoints ends(random, count);
     for (int i = 0; i < count; ++i) {
-        const Hierarchy::Point p =
-            hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
-        // Stratified over S as well: a cluster's children each get their share of rays.
-        const Hierarchy::Point q =
-            hierarchy_.Sample(s, (strata[i] + random.Uniform()) / count, random.Uniform());
+        const glm::dvec2 at = ends.Receiver(i), from = ends.Sender(strata[i]);
+        const Hierarchy::Point p = hierarchy_.Sample(r, at.x, at.y);
+        // Spread over S as well: a cluster's children each get their share of rays.
+        const Hierarchy::Point q = hierarchy_.Sample(s, from.x, from.y);
         const glm::dvec3 d = q.position - p.position;
         const double distance = glm::length(d);
         if (distance <= 0.0) continue;
@@ -199,18 +218,29 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
     thread_local std::vector<std::uint8_t> occluded;
     thread_local std::vector<std::int32_t> closed;
     starts.clear(), directions.clear(), weights.clear(), closed.clear();
-    // The cone's directions, stratified in its rings and turns and shuffled against the
-    // stratified points.
-    const int rings = beam ? 1 : std::max(1, static_cast<int>(std::sqrt(count)));
+    // The cone's directions, stratified in its rings and turns (a grid of exactly `count`
+    // cells, each taken once: of a grid with more, the cells left over would never be
+    // sampled) and shuffled against the points.
+    int rings = 1;
+    for (int d = 1; !beam && d * d <= count; ++d) {
+        if (count % d == 0) rings = d;
+    }
+    const int turns = count / rings;
+    const RankOneLattice& lattice = RankOneLattice::Of(count);
+    const glm::dvec2 shift(random.Uniform(), random.Uniform());
+    // The cells of the cone in a random order: in a fixed one, each point of the lattice
+    // would always take its direction from the same cell, a bias where a point lies
+    // and where the light comes from go together (the box of a closed instance).
+    thread_local std::vector<int> cells;
+    if (!beam) RandomStrata(random, cells, count);
     for (int i = 0; i < count; ++i) {
-        const Hierarchy::Point p =
-            hierarchy_.Sample(r, (i + random.Uniform()) / count, random.Uniform());
+        const glm::dvec2 at = lattice.Point(i, shift);
+        const Hierarchy::Point p = hierarchy_.Sample(r, at.x, at.y);
         glm::dvec3 toward = light.toward;
         if (!beam) {
-            const int cell = ShuffledStratum(i, count);
-            toward =
-                light.Direction((cell % rings + random.Uniform()) / rings,
-                                (cell / rings + random.Uniform()) / ((count + rings - 1) / rings));
+            const int cell = cells[i];
+            toward = light.Direction((cell % rings + random.Uniform()) / rings,
+                                     (cell / rings + random.Uniform()) / turns);
         }
         const double weight = model_.ReceivingWeight(p.triangle, p.normal, toward);
         if (weight <= 0.0) continue;

@@ -60,8 +60,9 @@ class LinkVisibility {
     // factor's kernel |cos θx| |cos θy| / |x − y|² (the receiving cosine as push-down hands
     // the light to patches). Unweighted, far pairs count as much as near ones and are more
     // often blocked: the 500-leaf canopy at ρ = τ = 0.45 lost 2.3 % of its NIR that way.
-    // The points are stratified over both ends, the sender's strata paired with the
-    // receiver's in a random order (RandomStrata): each child of a sending cluster gets its
+    // The points are spread over both ends, each end's on a rank-1 lattice (RankOneLattice),
+    // the sender's paired with the receiver's in a random order (RandomStrata): each child of
+    // a sending cluster gets its
     // share of the rays (drawn at random, the eight rays of a two-leaf cluster whose lower
     // leaf is hidden fell so that it sent 13 % too little: HrcExposure.AClusterSendsOnly…),
     // and no pair of strata is favoured (paired in a fixed order, the closed box of
@@ -91,7 +92,9 @@ class LinkVisibility {
     // points, each with a direction of the source's cone (stratified over it; one folded
     // back above the horizon where a sky cone dips below it, as the reference does),
     // weighted by |n · ω|, the weight with which push-down hands the source's light to each
-    // patch.
+    // patch. The points lie on a rank-1 lattice, which resolves a shadow edge across r in
+    // both coordinates: stratified along one alone, the 10,000-leaf tree's PAR was 1.81 %
+    // off the reference (L2, HRC at ε = 1e-4), 1.20 % now, for the same rays.
     // `set` picks the stream of rays, as for links between nodes.
     double FromSource(std::uint32_t r, std::uint32_t source, const DirectionalSource& light,
                       RaySet set, std::int64_t& rays) const;

@@ -93,13 +93,6 @@ inline glm::dvec3 UniformCone(const glm::dvec3& axis, double cosMax, double u, d
     return FromLocal(axis, {r * std::cos(phi), r * std::sin(phi), z});
 }
 
-// Stratum i of `count` in an order unrelated to i (multiplied by a prime modulo count; a
-// permutation for count < 7919): two coordinates stratified over the same samples then do
-// not pair stratum with stratum.
-inline int ShuffledStratum(int i, int count) {
-    return static_cast<int>((static_cast<std::int64_t>(i) * 7919) % count);
-}
-
 // 0 .. count − 1 in an order drawn from `random` (Fisher–Yates): a second coordinate
 // stratified over the same samples, its strata taken in this order, keeps each sample's
 // pair uniform (Latin hypercube sampling); in a fixed order, pairs stratum i only with
