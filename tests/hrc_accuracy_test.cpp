@@ -113,7 +113,7 @@ TEST(HrcAccuracy, SkyConesAreSoftShadowsNotHardBeams) {
         100 * mc, 100 * coarse, 100 * fine, 100 * sky, 100 * SideError(reference, mcCones, leaves),
         100 * SideError(reference, hrc4, leaves), 100 * SideError(reference, hrc5, leaves),
         100 * SideError(reference, hrcContinuous, leaves));
-    // Measured: 0.43, 0.95, 0.53 and 0.95 %. A cone that straddled a leaf's plane lit only
+    // Measured: 0.43, 0.94, 0.43 and 0.94 %. A cone that straddled a leaf's plane lit only
     // the side its axis faces: the canopy's leaves got 1.1 % too little direct light, and
     // HRC stood at 1.61 and 1.47 % (AConeAcrossALeafLightsBothItsSides). The cones add
     // nothing to HRC's error: what is left is HRC's at that ε, whatever the sky.
@@ -268,7 +268,8 @@ TEST(HrcAccuracy, AnIsotropicFieldLightsEverySideAlikeFromEveryDirection) {
 // √8 times less. With links' vectors towards their senders' centres, against 8,192 paths:
 // worst length 0.030, directions p95 2.9°, worst 7.3°; with the mean of ω over a plane
 // sender, 0.029, 2.6° and 5.6°; against 65,536 paths, with cones across a leaf lighting
-// both its sides, 0.030, 2.4° and 3.7° at ε = 1e-4 (0.016, 1.3° and 2.2° at 1e-5).
+// both its sides, 0.030, 2.4° and 3.7° at ε = 1e-4 (0.016, 1.3° and 2.2° at 1e-5); with
+// source rays from lattice points, 0.028, 2.5° and 4.2° at 1e-4.
 TEST(HrcAccuracy, LightVectorsUnderSunAndSkyFollowTheReference) {
     const int leaves = 250;
     const Scene scene = Canopy(leaves, SkyDiscretization::kTurtle46, 10.0, true);
@@ -370,7 +371,7 @@ double CrownHitShare(const PreparedScene& prepared, double half, bool discOnly) 
 // biases what they value): it is valued by a second set (Refiner::JudgeSource). Over
 // eight 3,000-leaf crowns at ε = 1e-4, the disc's light must be within 0.5 % of E times
 // the gap fraction, and the leaves' within 0.2 % of E times the area they shade. Valued by
-// the judging rays they were −2.37 % and −0.37 % off; −0.11 % and −0.03 % now. The crowns
+// the judging rays they were −2.37 % and −0.37 % off; −0.04 % and −0.04 % now. The crowns
 // scatter by σ ≈ 0.46 % (disc) and 0.14 % (leaves) from one to the next, so the bounds on
 // their mean are 3 and 4 of its standard errors; the grid's own error is below 10⁻⁴.
 TEST(HrcAccuracy, ASunLightsADenseCrownAndTheGroundBeneathAsRaysThroughItFind) {
