@@ -4,7 +4,6 @@
 #include <vector>
 
 #include "solver/util/box.h"
-#include "solver/util/lattice.h"
 #include "solver/util/sampling.h"
 
 namespace leaflux {
@@ -30,8 +29,8 @@ struct Exclusion {
 // of one end is always paired with the same point of the other.
 class EndPoints {
   public:
-    EndPoints(Random& random, int count)
-        : lattice_(RankOneLattice::Of(count)),
+    EndPoints(Random& random, const RankOneLattice& lattice)
+        : lattice_(lattice),
           receiver_(random.Uniform(), random.Uniform()),
           sender_(random.Uniform(), random.Uniform()) {}
     glm::dvec2 Receiver(int i) const { return lattice_.Point(i, receiver_); }
@@ -102,7 +101,7 @@ Sight LinkVisibility::BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet se
     RandomStrata(random, strata, count);
     const HrcNode& S = hierarchy_[s];
     const bool held = model_.Held(s);
-    const EndPoints ends(random, count);
+    const EndPoints ends(random, visibilityLattice_);
     double seen = 0.0, total = 0.0, passed = 0.0;
     int traced = 0;
     for (int i = 0; i < count; ++i) {
@@ -168,7 +167,7 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set,
     double visible = 0.0, total = 0.0, visibleLight = 0.0, totalLight = 0.0;
     int traced = 0;
     double passed = 0.0;
-    const EndPoints ends(random, count);
+    const EndPoints ends(random, visibilityLattice_);
     for (int i = 0; i < count; ++i) {
         const glm::dvec2 at = ends.Receiver(i), from = ends.Sender(strata[i]);
         const Hierarchy::Point p = hierarchy_.Sample(r, at.x, at.y);
@@ -226,7 +225,7 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
         if (count % d == 0) rings = d;
     }
     const int turns = count / rings;
-    const RankOneLattice& lattice = RankOneLattice::Of(count);
+    const RankOneLattice& lattice = sourceLattice_;
     const glm::dvec2 shift(random.Uniform(), random.Uniform());
     // The cells of the cone in a random order: in a fixed one, each point of the lattice
     // would always take its direction from the same cell, a bias where a point lies

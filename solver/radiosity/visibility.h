@@ -14,6 +14,7 @@
 #include "solver/radiosity/links.h"
 #include "solver/radiosity/node_model.h"
 #include "solver/raytrace/occlusion.h"
+#include "solver/util/lattice.h"
 
 namespace leaflux {
 
@@ -51,7 +52,9 @@ class LinkVisibility {
           field_(field),
           occlusion_(occlusion),
           visibilityRays_(visibilityRays),
-          sourceRays_(sourceRays) {}
+          sourceRays_(sourceRays),
+          visibilityLattice_(RankOneLattice::Of(visibilityRays)),
+          sourceLattice_(RankOneLattice::Of(sourceRays)) {}
 
     int VisibilityRays() const { return visibilityRays_; }
     int SourceRays() const { return sourceRays_; }
@@ -124,6 +127,8 @@ class LinkVisibility {
     const Field& field_;
     const Occlusion& occlusion_;
     const int visibilityRays_, sourceRays_;
+    // Where each end's rays start (its points are looked up once, not per link).
+    const RankOneLattice &visibilityLattice_, &sourceLattice_;
 };
 
 }  // namespace leaflux
