@@ -53,6 +53,11 @@ std::string Gigabytes(double bytes) {
 // time) and the text is never held whole.
 void WriteScene(const Scene& scene, const std::string& path, SceneWriting writing,
                 const std::function<void(double)>& progress) {
+    if (IsBinarySceneFile(path)) {  // one message, written whole
+        SaveSceneFile(scene, path, writing);
+        if (progress) progress(1.0);
+        return;
+    }
     v1::Scene message = ToProto(scene, writing);
     google::protobuf::RepeatedPtrField<v1::Node> nodes;
     nodes.Swap(message.mutable_nodes());
@@ -197,7 +202,10 @@ CLI::App* AddGenerateCommand(CLI::App& app, GenerateCommand& command) {
         "Also bands B (400–500 nm), G (500–600) and R (600–700): the PAR sun, sky or lamps "
         "split over them, green-leaf, bark and soil optics, for leaflux render --quantity colour");
     generate->add_flag("--quiet", command.quiet, "No progress bar");
-    generate->add_option("--out", command.out, "Scene file to write (its folder is made)")
+    generate
+        ->add_option("--out", command.out,
+                     "Scene file to write (its folder is made): protobuf text format, or binary if "
+                     "its name ends in .binpb (read faster)")
         ->required();
     return generate;
 }

@@ -495,10 +495,19 @@ v1::Scene ToProto(const Scene& scene, SceneWriting writing) {
     return message;
 }
 
+bool IsBinarySceneFile(const std::string& path) {
+    return std::filesystem::path(path).extension() == kBinarySceneExtension;
+}
+
 Scene LoadSceneFile(const std::string& path, const ImportOptions& options,
                     const SceneLimits& limits) {
     v1::Scene message;
-    if (const auto error = ReadTextFormat(path, message)) {
+    if (IsBinarySceneFile(path)) {
+        std::ifstream in(path, std::ios::binary);
+        if (!in) Fail(ErrorCode::kIo, path, "cannot open the scene file");
+        if (!message.ParseFromIstream(&in))
+            Fail(ErrorCode::kParse, path, "is not a binary leaflux.v1.Scene");
+    } else if (const auto error = ReadTextFormat(path, message)) {
         Fail(error->unreadable ? ErrorCode::kIo : ErrorCode::kParse, error->where,
              error->unreadable ? "cannot open the scene file" : error->what);
     }
@@ -506,10 +515,17 @@ Scene LoadSceneFile(const std::string& path, const ImportOptions& options,
 }
 
 void SaveSceneFile(const Scene& scene, const std::string& path, SceneWriting writing) {
-    std::string text;
-    google::protobuf::TextFormat::PrintToString(ToProto(scene, writing), &text);
-    std::ofstream out(path);
-    if (!out || !(out << text)) Fail(ErrorCode::kIo, path, "cannot write the scene file");
+    const v1::Scene message = ToProto(scene, writing);
+    std::ofstream out(path, std::ios::binary);
+    bool written = static_cast<bool>(out);
+    if (written && IsBinarySceneFile(path)) {
+        written = message.SerializeToOstream(&out);
+    } else if (written) {
+        std::string text;
+        google::protobuf::TextFormat::PrintToString(message, &text);
+        written = static_cast<bool>(out << text);
+    }
+    if (!written || !out.flush()) Fail(ErrorCode::kIo, path, "cannot write the scene file");
 }
 
 }  // namespace leaflux

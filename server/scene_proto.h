@@ -76,7 +76,11 @@ glm::dmat4 FrameFromProto(const v1::Frame& frame, const std::string& field,
 void FrameToProto(const glm::dmat4& m, v1::Frame* frame);  // nothing for the identity
 void MeshToProto(const Mesh& mesh, v1::Mesh* message);
 
-// Reads a scene file in protobuf text format; parse errors name line and column.
+// Reads a scene file in protobuf text format (parse errors name line and column), or in
+// protobuf's binary encoding when its name ends in .binpb (kBinarySceneExtension): the
+// same message, read faster and in less memory, for scenes of millions of triangles.
+inline constexpr const char* kBinarySceneExtension = ".binpb";
+bool IsBinarySceneFile(const std::string& path);
 Scene LoadSceneFile(const std::string& path, const ImportOptions& options = {},
                     const SceneLimits& limits = {});
 void SaveSceneFile(const Scene& scene, const std::string& path,

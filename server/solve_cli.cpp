@@ -44,7 +44,9 @@ void AddHrcSettings(CLI::App& app, HrcOptions& hrc, const std::string& prefix,
 }
 
 void AddSolverOptions(CLI::App& app, SolveCommand& command) {
-    app.add_option("--scene", command.scene, "Scene file (protobuf text format, leaflux.v1.Scene)")
+    app.add_option("--scene", command.scene,
+                   "Scene file (leaflux.v1.Scene in protobuf text format, or binary if its name "
+                   "ends in .binpb)")
         ->required()
         ->check(CLI::ExistingFile);
     app.add_option("--solver", command.solver,

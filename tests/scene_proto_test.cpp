@@ -2,10 +2,12 @@
 // mistake is an InputError naming the field (or file line and column).
 #include "server/scene_proto.h"
 
+#include <google/protobuf/util/message_differencer.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <set>
 
 #include "solver/generate/generator.h"
@@ -75,6 +77,46 @@ TEST(SceneFile, RoundTripsAGeneratedTreeKeepingSharedMeshes) {
     }
     EXPECT_EQ(meshes.size(), 2u);  // one leaf prototype, one internode prototype
     EXPECT_EQ(back.sources.skies[0].discretization, SkyDiscretization::kTurtle46);
+}
+
+// A file whose name ends in .binpb holds the same message in protobuf's binary encoding:
+// written and read back, it is the scene the text file gives; a file that is not one is
+// refused with a typed error naming it.
+TEST(SceneFile, ReadsAndWritesTheBinaryEncodingByItsName) {
+    Scene scene;
+    scene.bands = {{"PAR"}, {"NIR"}};
+    scene.optics = {{"leaf", {{0.1, 0.1, 0.05, 0.05}, {0.45, 0.45, 0.45, 0.45}}},
+                    {"stem", {{0.1, 0.1, 0, 0}, {0.4, 0.4, 0, 0}}}};
+    TreeParameters tree;
+    tree.leafCount = 40;
+    AddTree(scene, tree, {0, 0, 0});
+    scene.sources.suns.push_back({glm::normalize(glm::dvec3(0.3, -0.4, 0.8)), {400.0, 350.0}, 0.0});
+    const std::string text = ::testing::TempDir() + "tree.scene.txtpb",
+                      binary = ::testing::TempDir() + "tree.scene.binpb";
+    SaveSceneFile(scene, text);
+    SaveSceneFile(scene, binary);
+    std::ifstream in(binary, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    EXPECT_NE(bytes.substr(0, 7), "version");  // not text
+    const v1::Scene fromText = ToProto(LoadSceneFile(text)),
+                    fromBinary = ToProto(LoadSceneFile(binary));
+    EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(fromText, fromBinary));
+    EXPECT_EQ(fromBinary.nodes_size(), static_cast<int>(scene.nodes.size()));
+
+    const std::string garbage = Write("garbage.scene.binpb", "version: PROTOCOL_VERSION_CURRENT\n");
+    try {
+        LoadSceneFile(garbage);
+        ADD_FAILURE() << "a text file read as binary was accepted";
+    } catch (const InputError& error) {
+        EXPECT_EQ(error.Code(), ErrorCode::kParse);
+        EXPECT_EQ(error.Field(), garbage);
+    }
+    try {
+        LoadSceneFile(::testing::TempDir() + "absent.scene.binpb");
+        ADD_FAILURE() << "an absent file was accepted";
+    } catch (const InputError& error) {
+        EXPECT_EQ(error.Code(), ErrorCode::kIo);
+    }
 }
 
 TEST(SceneFile, ImportsCaribuWithItsOptics) {
