@@ -1,7 +1,7 @@
 // leaflux: the one-shot command line. `solve` lights a scene file, `render` draws its
-// light, `generate` writes a
-// procedural tree or plantation as a scene file, `policy check` shows the groups an
-// instantiation policy makes, `phase-db` inspects the phase-function database.
+// light, `generate` writes a procedural tree or plantation as a scene file, `convert` writes
+// one again (text or binary), `policy check` shows the groups an instantiation policy makes,
+// `phase-db` inspects the phase-function database.
 #include <fcntl.h>
 #include <google/protobuf/text_format.h>
 #include <spdlog/cfg/env.h>
@@ -24,6 +24,7 @@
 #include "server/cli_checks.h"
 #include "server/client.h"
 #include "server/client_cli.h"
+#include "server/convert_cli.h"
 #include "server/generate_cli.h"
 #include "server/instanced_cli.h"
 #include "server/phase_db_cli.h"
@@ -70,6 +71,8 @@ int main(int argc, char** argv) {
 
     GenerateCommand generate;
     CLI::App* generateApp = AddGenerateCommand(app, generate);
+    ConvertCommand convert;
+    CLI::App* convertApp = AddConvertCommand(app, convert);
 
     ClientCommand client;
     const ClientApps clientApps = AddClientCommand(app, client);
@@ -156,6 +159,7 @@ int main(int argc, char** argv) {
         if (solveApp->parsed()) return RunSolve(solve);
         if (renderApp->parsed()) return RunRender(render);
         if (generateApp->parsed()) return RunGenerate(generate, AvailableMemoryBytes());
+        if (convertApp->parsed()) return RunConvert(convert);
         if (policyCheckApp->parsed()) return RunPolicyCheck(policyCheck, std::cout);
         if (errorApp->parsed()) {
             if (errorBench.name.empty()) {

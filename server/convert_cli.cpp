@@ -1,0 +1,56 @@
+#include "server/convert_cli.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+
+#include "server/cli_checks.h"
+#include "server/scene_proto.h"
+#include "solver/util/error.h"
+
+namespace leaflux {
+
+CLI::App* AddConvertCommand(CLI::App& app, ConvertCommand& command) {
+    CLI::App* convert = app.add_subcommand(
+        "convert",
+        "Write a scene file again: as binary protobuf if --out ends in .binpb (read faster, "
+        "in less memory), else as text; imported OBJ, Caribu and OPF geometry taken in");
+    convert->add_option("--scene", command.scene, "Scene file to read (text, or .binpb)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    convert->add_option("--out", command.out, "Scene file to write (its folder is made)")
+        ->required();
+    convert->add_flag("--instanced", command.instanced,
+                      "Write subtrees that are exact copies once, as shared structures placed "
+                      "by a frame (Scene.structures, Scene.placements)");
+    convert->add_flag("--strict", command.strict,
+                      "Refuse imported geometry that carries no light instead of skipping it");
+    convert
+        ->add_option("--max-nodes", command.maxNodes,
+                     "Largest scene file taken, in nodes; a larger one is refused before it is "
+                     "built")
+        ->transform(WholeNumber())
+        ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+    return convert;
+}
+
+int RunConvert(const ConvertCommand& command) {
+    CheckWritable(command.out, "--out");  // and its folder made
+    const auto start = std::chrono::steady_clock::now();
+    SceneLimits limits;
+    limits.maxNodes = command.maxNodes;
+    const Scene scene = LoadSceneFile(command.scene, ImportOptions{command.strict}, limits);
+    SaveSceneFile(scene, command.out,
+                  command.instanced ? SceneWriting::kInstanced : SceneWriting::kFlat);
+    std::cout << "wrote " << command.out << ": " << scene.nodes.size() << " nodes, "
+              << (IsBinarySceneFile(command.out) ? "binary" : "text")
+              << (command.instanced ? ", instanced" : "") << ", "
+              << std::filesystem::file_size(command.out) << " bytes in "
+              << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+              << " s" << std::endl;
+    return 0;
+}
+
+}  // namespace leaflux
