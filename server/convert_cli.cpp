@@ -1,7 +1,5 @@
 #include "server/convert_cli.h"
 
-#include <spdlog/spdlog.h>
-
 #include <chrono>
 #include <filesystem>
 #include <iostream>

@@ -42,6 +42,14 @@ class EndPoints {
 };
 }  // namespace
 
+int LinkVisibility::ConeRings(int count) {
+    int rings = 1;
+    for (int d = 1; d * d <= count; ++d) {
+        if (count % d == 0) rings = d;
+    }
+    return rings;
+}
+
 double LinkVisibility::ClosedBrightness(std::int32_t closed, const glm::dvec3& towardQ) const {
     // A closed instance's radiance towards the ray: its intensity over its area seen.
     const std::uint32_t n = hierarchy_.NodeOfClosed(closed);
@@ -217,15 +225,6 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
     thread_local std::vector<std::uint8_t> occluded;
     thread_local std::vector<std::int32_t> closed;
     starts.clear(), directions.clear(), weights.clear(), closed.clear();
-    // The cone's directions, stratified in its rings and turns (a grid of exactly `count`
-    // cells, each taken once: of a grid with more, the cells left over would never be
-    // sampled) and shuffled against the points.
-    int rings = 1;
-    for (int d = 1; !beam && d * d <= count; ++d) {
-        if (count % d == 0) rings = d;
-    }
-    const int turns = count / rings;
-    const RankOneLattice& lattice = sourceLattice_;
     const glm::dvec2 shift(random.Uniform(), random.Uniform());
     // The cells of the cone in a random order: in a fixed one, each point of the lattice
     // would always take its direction from the same cell, a bias where a point lies
@@ -233,13 +232,13 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
     thread_local std::vector<int> cells;
     if (!beam) RandomStrata(random, cells, count);
     for (int i = 0; i < count; ++i) {
-        const glm::dvec2 at = lattice.Point(i, shift);
+        const glm::dvec2 at = sourceLattice_.Point(i, shift);
         const Hierarchy::Point p = hierarchy_.Sample(r, at.x, at.y);
         glm::dvec3 toward = light.toward;
         if (!beam) {
             const int cell = cells[i];
-            toward = light.Direction((cell % rings + random.Uniform()) / rings,
-                                     (cell / rings + random.Uniform()) / turns);
+            toward = light.Direction((cell % coneRings_ + random.Uniform()) / coneRings_,
+                                     (cell / coneRings_ + random.Uniform()) / coneTurns_);
         }
         const double weight = model_.ReceivingWeight(p.triangle, p.normal, toward);
         if (weight <= 0.0) continue;

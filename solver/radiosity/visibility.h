@@ -54,7 +54,9 @@ class LinkVisibility {
           visibilityRays_(visibilityRays),
           sourceRays_(sourceRays),
           visibilityLattice_(RankOneLattice::Of(visibilityRays)),
-          sourceLattice_(RankOneLattice::Of(sourceRays)) {}
+          sourceLattice_(RankOneLattice::Of(sourceRays)),
+          coneRings_(ConeRings(sourceRays)),
+          coneTurns_(sourceRays / coneRings_) {}
 
     int VisibilityRays() const { return visibilityRays_; }
     int SourceRays() const { return sourceRays_; }
@@ -129,6 +131,11 @@ class LinkVisibility {
     const int visibilityRays_, sourceRays_;
     // Where each end's rays start (its points are looked up once, not per link).
     const RankOneLattice &visibilityLattice_, &sourceLattice_;
+    // A sky cone's directions: a grid of rings × turns of exactly the source rays' count,
+    // each cell taken once (of a grid with more, the cells left over would never be
+    // sampled), its cells shuffled against the points.
+    static int ConeRings(int count);  // the largest divisor of count not over √count
+    const int coneRings_, coneTurns_;
 };
 
 }  // namespace leaflux
