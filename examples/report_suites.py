@@ -116,6 +116,12 @@ def accuracy_section(build, out, run=True):
          "150 leaves on a ±10 m and a ±200 m ground, per side against Monte Carlo, ε = 1e-4",
          "the same within noise",
          f"{v('ground_10m_pct')} % and {v('ground_200m_pct')} %"),
+        ("AGroundIsSplitForTheLightItSendsTheLeaves",
+         "20 leaves over a dark (ρ = 0.1) and a white (ρ = 0.9) ±10 m ground under a sun and the "
+         "46-cone sky, per side against Monte Carlo, ε = 1e-4",
+         "as accurate (within 1.5 times) with under half the white ground's links",
+         f"{v('dark_ground_pct')} % with {values['dark_ground_links']:,.0f} links; "
+         f"{v('white_ground_pct')} % with {values['white_ground_links']:,.0f}"),
         ("AnIsotropicFieldLightsEverySideAlikeFromEveryDirection",
          "RAMI's purist corner (ρ + τ = 1, white ±200 m ground, uniform sky): every side 100 W/m², v = 0",
          "‖v‖ ≤ 0.05; worst side ≤ 5 % at 1e-5",

@@ -24,6 +24,7 @@ NodeModel::NodeModel(Hierarchy& hierarchy, const Scene& scene, const RayScene& r
       bins_(directions.Size()),
       maxSubdivision_(maxSubdivision) {
     FindOrgans();
+    FindOnward(scene);
     FindInnerSides(scene);
     FindPlanes();
     ScaleLobes();
@@ -71,6 +72,36 @@ void NodeModel::FindOrgans() {
                 organs_[n] |= organs_[child];
                 held_[n] &= held_[child];
             }
+        }
+    }
+}
+
+void NodeModel::FindOnward(const Scene& scene) {
+    onwardOf_.assign(flat_.receivers.size(), 0.0f);
+    for (std::size_t r = 0; r < flat_.receivers.size(); ++r) {
+        const Receiver& receiver = flat_.receivers[r];
+        if (receiver.kind == ReceiverKind::kOrgan) {
+            onwardOf_[r] = 1.0f;
+            continue;
+        }
+        if (receiver.optics < 0) continue;  // black
+        double onward = 0.0;
+        for (const BandOptics& band : scene.optics[receiver.optics].bands) {
+            onward = std::max({onward, band.rhoUpper + band.tauUpperToLower,
+                               band.rhoLower + band.tauLowerToUpper});
+        }
+        onwardOf_[r] = static_cast<float>(std::min(onward, 1.0));
+    }
+    onward_.assign(hierarchy_.Size(), 0.0f);
+    for (std::uint32_t n = 0; n < hierarchy_.Size(); ++n) {
+        const HrcNode& node = hierarchy_[n];
+        if (node.patch) {
+            onward_[n] = onwardOf_[node.receiver];
+        } else if (node.closed >= 0) {
+            onward_[n] = 1.0f;
+        } else {
+            for (std::uint32_t child : node.children)
+                onward_[n] = std::max(onward_[n], onward_[child]);
         }
     }
 }
