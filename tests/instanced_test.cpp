@@ -461,6 +461,36 @@ TEST(Instanced, TheSceneMovedAndTurnedGetsTheSameLight) {
     EXPECT_LT(accuracy[1].l2PctOfMax, 1.5);
 }
 
+// Sibling instances are opened in parallel, each a problem of its own: on one core or on
+// every one, the same light, and the cores asked are those used.
+TEST(Instanced, OneCoreGivesTheLightOfEvery) {
+    const Scene scene = Copies(3, 60);
+    const PreparedScene prepared(scene);
+    PhaseDatabase database({});
+    InstancedOptions options;
+    options.hrc.epsilon = 1e-4;
+    options.hrc.threads = 1;
+    const InstancedSolution one =
+        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+    options.hrc.threads = 2;
+    const InstancedSolution two =
+        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+    EXPECT_EQ(one.solution.stats.threads, 1);
+    EXPECT_EQ(two.solution.stats.threads, 2);
+    // One core used: no more CPU time than wall time, within the clocks' ticks (on two,
+    // 1.7 times as much).
+    EXPECT_LE(one.solution.stats.cpuSeconds, 1.05 * one.solution.stats.wallSeconds + 0.02);
+    ASSERT_EQ(one.solution.light.size(), two.solution.light.size());
+    for (std::size_t r = 0; r < one.solution.light.size(); ++r) {
+        for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+            EXPECT_EQ(one.solution.light[r][b].irradianceUpperWm2,
+                      two.solution.light[r][b].irradianceUpperWm2);
+            EXPECT_EQ(one.solution.light[r][b].irradianceLowerWm2,
+                      two.solution.light[r][b].irradianceLowerWm2);
+        }
+    }
+}
+
 // The energy balance closes: what the suns and sky bring is absorbed or escapes, counting
 // what the closed instances send out of the scene. Plants without a ground, so that all
 // that escapes leaves the plants: before it was counted, the balance missed all of it (a

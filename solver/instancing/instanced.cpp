@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -563,13 +564,17 @@ InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& receivers,
                          "the instanced solver does not repeat a tile; use hrc or mc");
     const ResourceClock clock;
     InstancedSolution out;
+    // On the cores asked (hrc.threads), the functions computed as well as the problems.
+    const int threads =
+        options.hrc.threads > 0 ? options.hrc.threads : tbb::this_task_arena::max_concurrency();
+    tbb::task_arena arena(threads);
     const SceneSignatures signatures = ComputeSignatures(scene, policy);
-    const SceneOriginals originals =
-        OriginalsOf(scene, signatures, policy, options.originals, database);
+    const SceneOriginals originals = arena.execute(
+        [&] { return OriginalsOf(scene, signatures, policy, options.originals, database); });
     const InstanceTree tree(scene, signatures);
     InstancedSolve solve(scene, receivers, shadows, tree, originals, options, out);
     const auto start = std::chrono::steady_clock::now();
-    solve.Run();
+    arena.execute([&] { solve.Run(); });
     out.stats.solveSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     // The structures solved whole by node, and the problems by depth and size, whatever
@@ -589,6 +594,7 @@ InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& receivers,
     const std::int64_t rays = out.solution.stats.rays;
     clock.Stamp(out.solution.stats);
     out.solution.stats.rays = rays;
+    out.solution.stats.threads = threads;
     out.stats.peakRssBytes = out.solution.stats.peakRssBytes;
     spdlog::debug("instanced: {} parts, {} originals computed, {} reused", tree.Parts().size(),
                   originals.computed, originals.reused);

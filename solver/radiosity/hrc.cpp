@@ -4,7 +4,6 @@
 #include "solver/radiosity/hrc.h"
 
 #include <spdlog/spdlog.h>
-#include <tbb/info.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -157,7 +156,7 @@ class SceneSolve {
         solution.light.assign(flat_.receivers.size(), std::vector<BandLight>(channels_.bands));
         solution.balance.assign(channels_.bands, EnergyBalance{});
         const int threads =
-            options_.threads > 0 ? options_.threads : tbb::info::default_concurrency();
+            options_.threads > 0 ? options_.threads : tbb::this_task_arena::max_concurrency();
         tbb::task_arena arena(threads);
         if (hierarchy_.Root() != kNoNode) {
             arena.execute([&] { Solve(solution); });
@@ -521,7 +520,8 @@ Solution SceneSolve::RunLocal(NodeId root) {
     Solution solution;
     solution.light.assign(flat_.receivers.size(), std::vector<BandLight>(channels_.bands));
     solution.balance.assign(channels_.bands, EnergyBalance{});
-    const int threads = options_.threads > 0 ? options_.threads : tbb::info::default_concurrency();
+    const int threads =
+        options_.threads > 0 ? options_.threads : tbb::this_task_arena::max_concurrency();
     tbb::task_arena arena(threads);
     arena.execute([&] {
         // The light from outside, held fixed: the links from senders outside the subtree

@@ -92,7 +92,7 @@ struct HrcOptions {
     // After the solve, every kind of link against rays from the receivers, and the
     // partition of the exchanges among the links checked (Solution::linkAudit).
     bool auditLinks = false;
-    int threads = 0;  // 0: every core
+    int threads = 0;  // 0: every core of the calling task arena (all, outside one)
     // Called with the fraction of the solve done (0 to 1), when set: a progress bar. The
     // solve's stages take fixed parts of it (hrc.cpp, the Stage constants); within a stage, the
     // refinement counts the parts of its tasks carried out and the iteration how far its

@@ -494,7 +494,8 @@ Solution SolveGroup(const Scene& scene, const FlatScene& flat, const RayScene& r
     std::mutex progressMutex;
     int reported = 0;
 
-    const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
+    const int threads =
+        options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency();
     tbb::task_arena arena(threads);
     arena.execute([&] {
         tbb::parallel_for(std::uint32_t{0}, receivers, [&](std::uint32_t r) {

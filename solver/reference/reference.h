@@ -26,7 +26,7 @@ struct ReferenceOptions {
     int samplesPerReceiver = 1024;  // paths per receiver, rounded up to replicates · m²
     int replicates = 16;            // independent groups for the standard error (≥ 2)
     std::uint64_t seed = 1;
-    int threads = 0;        // 0: every core
+    int threads = 0;        // 0: every core of the calling task arena (all, outside one)
     int maxDepth = 100000;  // a safety net: with Russian roulette at ≤ 0.995,
                             // a path reaches it with probability < 1e-200
     // Direct light only: light straight from the suns, the sky and the lamps; what leaves
