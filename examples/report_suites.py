@@ -122,6 +122,11 @@ def accuracy_section(build, out, run=True):
          "as accurate (within 1.5 times) with under half the white ground's links",
          f"{v('dark_ground_pct')} % with {values['dark_ground_links']:,.0f} links; "
          f"{v('white_ground_pct')} % with {values['white_ground_links']:,.0f}"),
+        ("ALampBarLightsEachLeafSideAsRaysFind",
+         "400 leaves 1.3 m under a black lamp bar 5 m long, direct light only, per side against "
+         "Monte Carlo, ε = 1e-4",
+         "≤ 15 % per side (27 % when the lamp was split first); each side's sum within 2 %",
+         f"{v('lamp_side_pct')} %; lower sides {v('lamp_lower_ratio', 3)} of the reference's"),
         ("AnIsotropicFieldLightsEverySideAlikeFromEveryDirection",
          "RAMI's purist corner (ρ + τ = 1, white ±200 m ground, uniform sky): every side 100 W/m², v = 0",
          "‖v‖ ≤ 0.05; worst side ≤ 5 % at 1e-5",
