@@ -2,7 +2,6 @@
 
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -20,6 +19,7 @@
 #include "solver/scene/geometry.h"
 #include "solver/util/box.h"
 #include "solver/util/check.h"
+#include "solver/util/cores.h"
 #include "solver/util/directions.h"
 #include "solver/util/error.h"
 #include "solver/util/memory.h"
@@ -565,16 +565,16 @@ InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& receivers,
     const ResourceClock clock;
     InstancedSolution out;
     // On the cores asked (hrc.threads), the functions computed as well as the problems.
-    const int threads =
-        options.hrc.threads > 0 ? options.hrc.threads : tbb::this_task_arena::max_concurrency();
-    tbb::task_arena arena(threads);
+    const int threads = CoresOf(options.hrc.threads);
     const SceneSignatures signatures = ComputeSignatures(scene, policy);
-    const SceneOriginals originals = arena.execute(
-        [&] { return OriginalsOf(scene, signatures, policy, options.originals, database); });
+    SceneOriginals originals;
+    OnCores(threads, [&] {
+        originals = OriginalsOf(scene, signatures, policy, options.originals, database);
+    });
     const InstanceTree tree(scene, signatures);
     InstancedSolve solve(scene, receivers, shadows, tree, originals, options, out);
     const auto start = std::chrono::steady_clock::now();
-    arena.execute([&] { solve.Run(); });
+    OnCores(threads, [&] { solve.Run(); });
     out.stats.solveSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     // The structures solved whole by node, and the problems by depth and size, whatever

@@ -4,7 +4,6 @@
 #include "solver/radiosity/hrc.h"
 
 #include <spdlog/spdlog.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -26,6 +25,7 @@
 #include "solver/radiosity/traversal.h"
 #include "solver/radiosity/visibility.h"
 #include "solver/util/check.h"
+#include "solver/util/cores.h"
 #include "solver/util/error.h"
 
 namespace leaflux {
@@ -155,12 +155,8 @@ class SceneSolve {
         Solution solution;
         solution.light.assign(flat_.receivers.size(), std::vector<BandLight>(channels_.bands));
         solution.balance.assign(channels_.bands, EnergyBalance{});
-        const int threads =
-            options_.threads > 0 ? options_.threads : tbb::this_task_arena::max_concurrency();
-        tbb::task_arena arena(threads);
-        if (hierarchy_.Root() != kNoNode) {
-            arena.execute([&] { Solve(solution); });
-        }
+        const int threads = CoresOf(options_.threads);
+        if (hierarchy_.Root() != kNoNode) OnCores(threads, [&] { Solve(solution); });
         clock.Stamp(solution.stats);
         solution.stats.threads = threads;
         solution.stats.rays = rays();
@@ -520,10 +516,8 @@ Solution SceneSolve::RunLocal(NodeId root) {
     Solution solution;
     solution.light.assign(flat_.receivers.size(), std::vector<BandLight>(channels_.bands));
     solution.balance.assign(channels_.bands, EnergyBalance{});
-    const int threads =
-        options_.threads > 0 ? options_.threads : tbb::this_task_arena::max_concurrency();
-    tbb::task_arena arena(threads);
-    arena.execute([&] {
+    const int threads = CoresOf(options_.threads);
+    OnCores(threads, [&] {
         // The light from outside, held fixed: the links from senders outside the subtree
         // into it (their senders never split nor updated), the source links into it, and
         // what b's ancestors hand down.

@@ -1,7 +1,6 @@
 #include "solver/reference/reference.h"
 
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -13,6 +12,7 @@
 #include <unordered_map>
 
 #include "solver/util/check.h"
+#include "solver/util/cores.h"
 #include "solver/util/memory.h"
 #include "solver/util/sampling.h"
 
@@ -494,10 +494,8 @@ Solution SolveGroup(const Scene& scene, const FlatScene& flat, const RayScene& r
     std::mutex progressMutex;
     int reported = 0;
 
-    const int threads =
-        options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency();
-    tbb::task_arena arena(threads);
-    arena.execute([&] {
+    const int threads = CoresOf(options.threads);
+    OnCores(threads, [&] {
         tbb::parallel_for(std::uint32_t{0}, receivers, [&](std::uint32_t r) {
             SetFlushToZero();
             const Receiver& receiver = flat.receivers[r];
