@@ -78,8 +78,10 @@ void NodeModel::FindOrgans() {
 
 void NodeModel::FindOnward(const Scene& scene) {
     onwardOf_.assign(flat_.receivers.size(), 0.0f);
+    lampOf_.assign(flat_.receivers.size(), 0);
     for (std::size_t r = 0; r < flat_.receivers.size(); ++r) {
         const Receiver& receiver = flat_.receivers[r];
+        lampOf_[r] = receiver.kind == ReceiverKind::kEmitter && receiver.optics < 0;
         if (receiver.kind == ReceiverKind::kOrgan) {
             onwardOf_[r] = 1.0f;
             continue;
@@ -93,15 +95,20 @@ void NodeModel::FindOnward(const Scene& scene) {
         onwardOf_[r] = static_cast<float>(std::min(onward, 1.0));
     }
     onward_.assign(hierarchy_.Size(), 0.0f);
+    lamps_.assign(hierarchy_.Size(), 0);
     for (std::uint32_t n = 0; n < hierarchy_.Size(); ++n) {
         const HrcNode& node = hierarchy_[n];
         if (node.patch) {
             onward_[n] = onwardOf_[node.receiver];
+            lamps_[n] = lampOf_[node.receiver];
         } else if (node.closed >= 0) {
             onward_[n] = 1.0f;
         } else {
-            for (std::uint32_t child : node.children)
+            lamps_[n] = !node.children.empty();
+            for (std::uint32_t child : node.children) {
                 onward_[n] = std::max(onward_[n], onward_[child]);
+                lamps_[n] &= lamps_[child];
+            }
         }
     }
 }

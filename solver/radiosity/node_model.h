@@ -92,6 +92,12 @@ class NodeModel {
         return (1.0 + (gap / organsRadius_) * (gap / organsRadius_)) /
                std::max(Onward(n), kLeastOnward);
     }
+    // n's surfaces are all lamps without optics (black emitters): its light is its
+    // exitance, even over it.
+    bool Lamp(std::uint32_t n) const {
+        const HrcNode& node = hierarchy_[n];
+        return node.patch ? lampOf_[node.receiver] != 0 : lamps_[n] != 0;
+    }
     // The largest share of the light it takes that a node's surfaces send on, ρ + τ, over
     // bands and sides: 1 over an organ or a closed instance. (Clusters are never built
     // after the model: onward_ covers them.)
@@ -156,6 +162,7 @@ class NodeModel {
   private:
     void FindOrgans();
     void FindInnerSides(const Scene& scene);
+    // Onward and Lamp.
     void FindOnward(const Scene& scene);
     void FindPlanes();
     void ScaleLobes();
@@ -181,6 +188,8 @@ class NodeModel {
     static constexpr double kLeastOnward = 0.01;
     std::vector<float> onwardOf_;       // by receiver: Onward of its patches
     std::vector<float> onward_;         // by node as built: Onward
+    std::vector<std::uint8_t> lampOf_;  // by receiver: Lamp of its patches
+    std::vector<std::uint8_t> lamps_;   // by node as built: Lamp
     std::vector<std::uint8_t> organs_;  // by node as built: 1 over an organ
     std::vector<std::uint8_t> held_;    // by node as built: Held
     std::vector<std::uint8_t> planes_;  // by node as built: Planar

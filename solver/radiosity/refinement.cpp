@@ -168,9 +168,7 @@ Refiner::Verdict::Kind Refiner::SplitChoice(std::uint32_t r, std::uint32_t s) co
     // The greenhouse's lamp bars, each split into 128 slivers first, lit its leaves 5.8 % off
     // the reference (L2, PAR, ε = 1e-4; now 3.1 %), and with direct light alone at 1e-5 its
     // lower sides 2.7 times what rays find (now 1.05; HrcAccuracy.ALampBarLightsEach…).
-    if (model_.Shared(r) && model_.Planar(s) && model_.Onward(s) <= 0.0 &&
-        field_.emitted[s] > 0.0 && CanSplit(r))
-        return Verdict::kSplitReceiver;
+    if (model_.Shared(r) && model_.Lamp(s) && CanSplit(r)) return Verdict::kSplitReceiver;
     const bool receiverLarger = hierarchy_[r].radius >= hierarchy_[s].radius;
     const auto larger = receiverLarger ? Verdict::kSplitReceiver : Verdict::kSplitSender;
     const auto smaller = receiverLarger ? Verdict::kSplitSender : Verdict::kSplitReceiver;
