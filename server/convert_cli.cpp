@@ -23,23 +23,14 @@ CLI::App* AddConvertCommand(CLI::App& app, ConvertCommand& command) {
     convert->add_flag("--instanced", command.instanced,
                       "Write subtrees that are exact copies once, as shared structures placed "
                       "by a frame (Scene.structures, Scene.placements)");
-    convert->add_flag("--strict", command.strict,
-                      "Refuse imported geometry that carries no light instead of skipping it");
-    convert
-        ->add_option("--max-nodes", command.maxNodes,
-                     "Largest scene file taken, in nodes; a larger one is refused before it is "
-                     "built")
-        ->transform(WholeNumber())
-        ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+    AddSceneFileOptions(*convert, command.file);
     return convert;
 }
 
 int RunConvert(const ConvertCommand& command) {
     CheckWritable(command.out, "--out");  // and its folder made
     const auto start = std::chrono::steady_clock::now();
-    SceneLimits limits;
-    limits.maxNodes = command.maxNodes;
-    const Scene scene = LoadSceneFile(command.scene, ImportOptions{command.strict}, limits);
+    const Scene scene = LoadSceneFile(command.scene, command.file);
     SaveSceneFile(scene, command.out,
                   command.instanced ? SceneWriting::kInstanced : SceneWriting::kFlat);
     std::cout << "wrote " << command.out << ": " << scene.nodes.size() << " nodes, "

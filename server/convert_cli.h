@@ -4,15 +4,16 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-#include <cstddef>
 #include <string>
+
+#include "server/scene_file_cli.h"
 
 namespace leaflux {
 
 struct ConvertCommand {
     std::string scene, out;
-    bool instanced = false, strict = false;
-    std::size_t maxNodes = 1'000'000;
+    bool instanced = false;
+    SceneFileOptions file;  // --strict, --max-nodes
 };
 
 // The `convert` subcommand of `app`, its options bound to `command`.

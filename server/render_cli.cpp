@@ -165,7 +165,7 @@ int RunRender(const RenderCommand& command) {
         solved = SolveScene(solve, check);
     } else {
         solved = std::make_unique<SolvedScene>();
-        solved->scene = LoadCommandScene(command.solve);
+        solved->scene = LoadSceneFile(command.solve.scene, command.solve.file);
         check(solved->scene);
     }
     if (!solved->prepared) solved->prepared.emplace(solved->scene);  // the camera's rays

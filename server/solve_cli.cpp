@@ -76,13 +76,7 @@ void AddSolverOptions(CLI::App& app, SolveCommand& command) {
         ->transform(WholeNumber())
         ->check(CLI::Range(0, 1024));
     app.add_flag("--quiet", command.quiet, "No progress or log lines, only the summary");
-    app.add_flag("--strict", command.strict, kStrictHelp);
-    app.add_option("--max-nodes", command.maxNodes,
-                   "Largest scene file taken, in nodes (a generated tree of 10^6 leaves has "
-                   "2.3 million); a larger one is refused before it is built")
-        ->capture_default_str()
-        ->transform(WholeNumber())
-        ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+    AddSceneFileOptions(app, command.file);
 }
 
 CLI::App* AddSolveCommand(CLI::App& app, SolveCommand& command) {
@@ -108,17 +102,11 @@ CLI::App* AddSolveCommand(CLI::App& app, SolveCommand& command) {
     return solve;
 }
 
-Scene LoadCommandScene(const SolveCommand& command) {
-    SceneLimits limits;
-    limits.maxNodes = command.maxNodes;
-    return LoadSceneFile(command.scene, ImportOptions{command.strict}, limits);
-}
-
 std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
                                         const std::function<void(const Scene&)>& check) {
     const auto start = std::chrono::steady_clock::now();
     auto solved = std::make_unique<SolvedScene>();
-    solved->scene = LoadCommandScene(command);
+    solved->scene = LoadSceneFile(command.scene, command.file);
     const Scene& scene = solved->scene;
     if (check) check(scene);
     // The solver's working memory: its peak from here less what the loaded scene holds.

@@ -10,32 +10,26 @@
 #include <string>
 
 #include "server/instanced_cli.h"
-#include "server/scene_proto.h"
+#include "server/scene_file_cli.h"
 #include "solver/radiosity/hrc.h"
 #include "solver/solve.h"
 
 namespace leaflux {
 
-inline constexpr const char* kStrictHelp =
-    "Refuse imported files holding geometry that carries no light (zero-area faces, "
-    "zero-length organs, NaN diameters) instead of skipping it with a warning";
-
 struct SolveCommand {
     std::string scene, solver = "hrc", out, structures, ply;
     int samples = 1024, replicates = 16, threads = 0;
-    std::size_t maxNodes = SceneLimits{}.maxNodes;
     double epsilon = 1e-4;
     HrcOptions hrc;  // subdivision, rays and directions; ε and threads are set apart
     std::uint64_t seed = 1;
-    bool directOnly = false, quiet = false, strict = false;
+    bool directOnly = false, quiet = false;
+    SceneFileOptions file;  // --strict, --max-nodes
     InstancedCommand instanced;
 };
 
 // HRC's settings besides ε, as options named `prefix` + name, their help after `label`.
 void AddHrcSettings(CLI::App& app, HrcOptions& hrc, const std::string& prefix,
                     const std::string& label);
-// The command's scene file, within its --max-nodes.
-Scene LoadCommandScene(const SolveCommand& command);
 // The scene, the solver and its settings, as `solve` and `render` take them.
 void AddSolverOptions(CLI::App& app, SolveCommand& command);
 CLI::App* AddSolveCommand(CLI::App& app, SolveCommand& command);
