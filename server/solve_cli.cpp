@@ -112,13 +112,15 @@ std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
     // The solver's working memory: its peak from here less what the loaded scene holds.
     const std::int64_t loaded = ResidentBytes(), loadingPeak = PeakRssBytes();
     const bool peakReset = ResetPeakRss();
-    // The instanced solver with shadows by transmittance never flattens the scene whole.
+    // The instanced solver never flattens the scene whole: with shadows by geometry, the
+    // organs' triangles go straight into the ray engine.
     const bool instanced = command.solver == "instanced";
-    const bool whole = !instanced || ShadowsByGeometry(command.instanced);
-    if (whole) {
+    if (!instanced) {
         solved->prepared.emplace(scene);
     } else {
         solved->receivers = ReceiversOf(scene);
+        if (ShadowsByGeometry(command.instanced))
+            solved->shadows = OrganRays(scene, solved->receivers);
     }
     const FlatScene& flat = solved->Flat();
     SolverSettings settings;
@@ -139,10 +141,9 @@ std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
         settings.monteCarlo.progress = ProgressBar("Monte Carlo");
         if (settings.kind == SolverKind::kHrc) settings.hrc.progress = ProgressBar("HRC");
     }
-    solved->solution = instanced
-                           ? RunInstanced(scene, flat, whole ? &solved->prepared->Rays() : nullptr,
-                                          settings.hrc, command.instanced)
-                           : Solve(*solved->prepared, settings);
+    solved->solution = instanced ? RunInstanced(scene, flat, solved->shadows.get(), settings.hrc,
+                                                command.instanced)
+                                 : Solve(*solved->prepared, settings);
     SolveStats& stats = solved->solution.stats;
     if (peakReset) {
         stats.loadedRssBytes = loaded;
@@ -174,7 +175,8 @@ int RunSolve(const SolveCommand& command) {
     if (!command.ply.empty()) {
         std::ofstream ply(command.ply);
         if (!ply) throw InputError(ErrorCode::kIo, command.ply, "cannot write");
-        WritePly(ply, flat, solution, 0);
+        // The instanced solver's receivers hold no triangles.
+        WritePly(ply, flat.triangles.empty() ? Flatten(scene) : flat, solution, 0);
     }
     std::cout << Summary(command.solver, scene, flat, solution) << std::endl;
     for (const LinkAudit& audit : solution.linkAudit) {

@@ -34,13 +34,14 @@ void AddHrcSettings(CLI::App& app, HrcOptions& hrc, const std::string& prefix,
 void AddSolverOptions(CLI::App& app, SolveCommand& command);
 CLI::App* AddSolveCommand(CLI::App& app, SolveCommand& command);
 
-// A scene file loaded and solved. `prepared` holds the whole scene's rays unless the
-// instanced solver cast its shadows by transmittance (then `receivers` are the results'
-// receivers).
+// A scene file loaded and solved. `prepared` holds the whole scene's rays, but for the
+// instanced solver: then `receivers` are the results' receivers, and `shadows` its organs'
+// rays when it casts shadows by geometry.
 struct SolvedScene {
     Scene scene;
     std::optional<PreparedScene> prepared;
     FlatScene receivers;
+    std::unique_ptr<RayScene> shadows;
     Solution solution;
 
     const FlatScene& Flat() const { return prepared ? prepared->Flat() : receivers; }

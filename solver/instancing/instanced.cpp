@@ -76,6 +76,12 @@ class InstancedSolve {
                 firstOther_ = r;
             }
         }
+        const auto worldFromLocal = WorldFromLocal(scene);
+        for (const Node& node : scene.nodes) {
+            if (!node.organ) continue;
+            for (const Triangle& t : PlaceMesh(*node.organ->mesh, worldFromLocal.at(node.id)))
+                organAreaNormals_.push_back(glm::vec3(t.areaM2 * t.normal));
+        }
         out_.solution.light.assign(receivers.receivers.size(),
                                    std::vector<BandLight>(scene.bands.size()));
         out_.solution.balance.assign(scene.bands.size(), EnergyBalance{});
@@ -170,6 +176,9 @@ class InstancedSolve {
     std::unordered_map<NodeId, std::uint32_t> organReceiver_;
     std::uint32_t firstOther_ = kNoReceiver;  // the first environment surface or emitter
     std::uint32_t organTriangles_ = 0;        // of the receivers, the organs' first
+    // A n of every organ triangle of the scene: Σ A |n · ω| scales ε at the top as it
+    // scales HRC's on the flattened scene (LevelProblem::organsProjectedArea).
+    std::vector<glm::vec3> organAreaNormals_;
     // The top's surfaces as solved, each patch side that sends light an emitter, which
     // every opened instance holds (ReceiverKind::kHeld); their meshes shared.
     std::vector<Emitter> held_;
@@ -288,7 +297,14 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     problem.sources = std::move(sources);
     problem.errorW = errorW_;
     problem.sourceCount = sourceCount_;
-    if (p == InstanceTree::kTop) problem.organs = &receivers_;  // ε as HRC takes it
+    if (p == InstanceTree::kTop) {  // ε as HRC takes it
+        problem.organsProjectedArea = [this](const glm::dvec3& omega) {
+            double area = 0.0;
+            for (const glm::vec3& an : organAreaNormals_)
+                area += std::abs(glm::dot(glm::dvec3(an), omega));
+            return area;
+        };
+    }
     problem.splitSurfaces = true;  // the surfaces' light, held by the contents (Build)
     problem.holdLevel = options_.holdOutside;
     LevelSolution light = SolveLevel(level.scene, level.flat, *level.rays, options_.hrc,

@@ -240,17 +240,18 @@ class SceneSolve {
     }
     void Outputs(Solution& solution);
     // Σ A |n · ω| over the organs' triangles and the closed instances (the whole
-    // hierarchy's when there are none).
+    // hierarchy's when there are none), or LevelProblem::organsProjectedArea.
     double OrgansProjectedArea(const glm::dvec3& omega) const {
+        if (level_.organsProjectedArea) {
+            if (const double area = level_.organsProjectedArea(omega); area > 0.0) return area;
+        }
         double area = 0.0;
         bool organs = false;
-        const FlatScene& flat = level_.organs != nullptr ? *level_.organs : flat_;
-        for (const Triangle& t : flat.triangles) {
-            if (flat.receivers[t.receiver].kind != ReceiverKind::kOrgan) continue;
+        for (const Triangle& t : flat_.triangles) {
+            if (flat_.receivers[t.receiver].kind != ReceiverKind::kOrgan) continue;
             organs = true;
             area += t.areaM2 * std::abs(glm::dot(t.normal, omega));
         }
-        if (level_.organs != nullptr && organs) return area;
         for (std::size_t n = 0; n < hierarchy_.Size(); ++n) {
             if (hierarchy_[n].closed < 0 || model_.Held(static_cast<std::uint32_t>(n))) continue;
             organs = true;

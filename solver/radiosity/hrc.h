@@ -157,10 +157,11 @@ struct LevelProblem {
     // (Thresholds); errorW 0: ε times the power the sources bring onto its organs.
     double errorW = 0.0;
     std::size_t sourceCount = 0;
-    // With errorW 0: the organs whose unoccluded projected area scales ε, in place of the
-    // level's own organs and closed instances (the top of an instanced solve: every organ
-    // in every instance, so that ε means what it means to HRC on the flattened scene).
-    const FlatScene* organs = nullptr;
+    // With errorW 0: Σ A |n · ω| over the organs whose unoccluded projected area scales ε,
+    // in place of the level's own organs and closed instances (the top of an instanced
+    // solve: every organ in every instance, so that ε means what it means to HRC on the
+    // flattened scene). Empty: the level's own.
+    std::function<double(const glm::dvec3& omega)> organsProjectedArea;
     // Whether to tell apart, of what arrived on each closed instance, the light of the
     // level's surfaces (LevelSolution::surfaceBins), and to hand them on (surfaces).
     bool splitSurfaces = false;

@@ -112,27 +112,39 @@ std::shared_ptr<RayDevice> RayDevice::Shared() {
 RayScene::RayScene(const FlatScene& flat, std::optional<PeriodicDomain> periodic,
                    std::shared_ptr<RayDevice> device, std::uint32_t triangles)
     : flat_(flat), periodic_(periodic), device_(std::move(device)) {
+    const std::size_t count = std::min<std::size_t>(flat.triangles.size(), triangles);
+    BuildMesh(count, [&](float* xyz) {
+        for (std::size_t t = 0; t < count; ++t) {
+            const Triangle& tri = flat.triangles[t];
+            for (const glm::dvec3* corner : {&tri.a, &tri.b, &tri.c}) {
+                *xyz++ = static_cast<float>(corner->x);
+                *xyz++ = static_cast<float>(corner->y);
+                *xyz++ = static_cast<float>(corner->z);
+            }
+        }
+    });
+    BuildTop();
+}
+
+RayScene::RayScene(const FlatScene& frame, std::uint32_t triangles,
+                   const std::function<void(float*)>& place, std::shared_ptr<RayDevice> device)
+    : flat_(frame), device_(std::move(device)) {
+    BuildMesh(triangles, place);
+    BuildTop();
+}
+
+void RayScene::BuildMesh(std::size_t count, const std::function<void(float*)>& place) {
     SetFlushToZero();
     RTCDevice rtc = device_->Get();
     mesh_ = rtcNewScene(rtc);
     rtcSetSceneBuildQuality(mesh_, RTC_BUILD_QUALITY_HIGH);
-    const std::size_t count = std::min<std::size_t>(flat.triangles.size(), triangles);
     if (count > 0) {
         RTCGeometry geometry = rtcNewGeometry(rtc, RTC_GEOMETRY_TYPE_TRIANGLE);
-        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-            geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * count));
+        place(static_cast<float*>(rtcSetNewGeometryBuffer(
+            geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * count)));
         auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
             geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), count));
-        for (std::size_t t = 0; t < count; ++t) {
-            const Triangle& tri = flat.triangles[t];
-            const glm::dvec3* corners[3] = {&tri.a, &tri.b, &tri.c};
-            for (int v = 0; v < 3; ++v) {
-                vertices[9 * t + 3 * v + 0] = static_cast<float>(corners[v]->x);
-                vertices[9 * t + 3 * v + 1] = static_cast<float>(corners[v]->y);
-                vertices[9 * t + 3 * v + 2] = static_cast<float>(corners[v]->z);
-                indices[3 * t + v] = static_cast<unsigned>(3 * t + v);
-            }
-        }
+        for (std::size_t i = 0; i < 3 * count; ++i) indices[i] = static_cast<unsigned>(i);
         rtcSetGeometryIntersectFilterFunction(geometry, IgnoreStartTriangle);
         rtcSetGeometryOccludedFilterFunction(geometry, IgnoreStartTriangle);
         rtcCommitGeometry(geometry);
@@ -140,11 +152,15 @@ RayScene::RayScene(const FlatScene& flat, std::optional<PeriodicDomain> periodic
         rtcReleaseGeometry(geometry);  // the scene holds it now
     }
     rtcCommitScene(mesh_);
+}
+
+void RayScene::BuildTop() {
     if (!periodic_) {
         top_ = mesh_;
         rtcRetainScene(top_);
         return;
     }
+    RTCDevice rtc = device_->Get();
     top_ = rtcNewScene(rtc);
     const double width = periodic_->xMax - periodic_->xMin;
     const double depth = periodic_->yMax - periodic_->yMin;
@@ -334,6 +350,14 @@ bool RayScene::Occluded(const RayStart& start, const glm::dvec3& direction,
         remaining -= toSide;
     }
     return false;
+}
+
+std::unique_ptr<RayScene> OrganRays(const Scene& scene, const FlatScene& receivers) {
+    std::uint32_t organs = 0;
+    for (const Receiver& receiver : receivers.receivers)
+        if (receiver.kind == ReceiverKind::kOrgan) organs += receiver.triangleCount;
+    return std::make_unique<RayScene>(receivers, organs,
+                                      [&](float* xyz) { PlaceOrgans(scene, receivers, xyz); });
 }
 
 }  // namespace leaflux

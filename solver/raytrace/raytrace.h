@@ -9,6 +9,7 @@
 #include <embree3/rtcore.h>
 
 #include <cstdint>
+#include <functional>
 #include <glm/glm.hpp>
 #include <limits>
 #include <memory>
@@ -70,6 +71,12 @@ class RayScene {
     RayScene(const FlatScene& flat, std::optional<PeriodicDomain> periodic,
              std::shared_ptr<RayDevice> device = RayDevice::Shared(),
              std::uint32_t triangles = kNoTriangle);
+    // Over `triangles` triangles that `place` writes, 9 floats each, in the frame of
+    // `frame` (origin, bounds; its triangles unused): the whole scene's organs without a
+    // flat scene of them (PlaceOrgans). Not periodic.
+    RayScene(const FlatScene& frame, std::uint32_t triangles,
+             const std::function<void(float*)>& place,
+             std::shared_ptr<RayDevice> device = RayDevice::Shared());
     ~RayScene();
     RayScene(const RayScene&) = delete;
     RayScene& operator=(const RayScene&) = delete;
@@ -107,6 +114,8 @@ class RayScene {
     bool Periodic() const { return periodic_.has_value(); }
 
   private:
+    void BuildMesh(std::size_t count, const std::function<void(float*)>& place);
+    void BuildTop();  // the mesh, or its 9 periodic copies
     template <class Direction>
     void OccludedAlong(const std::vector<RayStart>& starts, const Direction& direction,
                        bool coherent, std::vector<std::uint8_t>& occluded) const;
@@ -123,5 +132,10 @@ class RayScene {
     RTCScene mesh_ = nullptr;  // the triangles
     RTCScene top_ = nullptr;   // the triangles, or 9 instances of them in a periodic scene
 };
+
+// The scene's organs alone in a ray engine, in the frame of `receivers` (ReceiversOf the
+// scene), placed straight into it: the instanced solver's exact shadows without a flat
+// scene of the triangles in double precision.
+std::unique_ptr<RayScene> OrganRays(const Scene& scene, const FlatScene& receivers);
 
 }  // namespace leaflux

@@ -4,18 +4,71 @@
 
 namespace leaflux {
 namespace {
-void AddReceiver(const std::vector<Triangle>& placed, Receiver receiver,
-                 std::vector<Triangle>& worldTriangles, FlatScene& flat) {
-    receiver.firstTriangle = static_cast<std::uint32_t>(worldTriangles.size());
-    const auto receiverIndex = static_cast<std::uint32_t>(flat.receivers.size());
-    for (Triangle t : placed) {
-        t.receiver = receiverIndex;
-        receiver.areaM2 += t.areaM2;
-        worldTriangles.push_back(t);
+// Appends a receiver of the placed triangles: its area and triangle range, and the
+// triangles themselves when `triangles` is kept (else only their count and bounds).
+struct Flattening {
+    FlatScene flat;
+    bool keep = true;
+    std::vector<Triangle> triangles;
+    std::uint32_t count = 0;
+    glm::dvec3 lo{std::numeric_limits<double>::max()}, hi{-std::numeric_limits<double>::max()};
+
+    void Add(const std::vector<Triangle>& placed, Receiver receiver) {
+        receiver.firstTriangle = count;
+        const auto receiverIndex = static_cast<std::uint32_t>(flat.receivers.size());
+        for (Triangle t : placed) {
+            t.receiver = receiverIndex;
+            receiver.areaM2 += t.areaM2;
+            lo = glm::min(lo, glm::min(t.a, glm::min(t.b, t.c)));
+            hi = glm::max(hi, glm::max(t.a, glm::max(t.b, t.c)));
+            if (keep) triangles.push_back(t);
+        }
+        count += static_cast<std::uint32_t>(placed.size());
+        receiver.triangleCount = count - receiver.firstTriangle;
+        flat.receivers.push_back(std::move(receiver));
     }
-    receiver.triangleCount =
-        static_cast<std::uint32_t>(worldTriangles.size()) - receiver.firstTriangle;
-    flat.receivers.push_back(std::move(receiver));
+};
+
+// Flatten, with or without the triangles.
+FlatScene FlattenScene(const Scene& scene, const PlacedOrgans& placed, bool keep) {
+    Flattening out;
+    out.keep = keep;
+    for (const Node& node : scene.nodes) {
+        if (!node.organ) continue;
+        out.Add(placed(node), {scene.NodeName(node), ReceiverKind::kOrgan, node.id,
+                               scene.OpticsIndex(node.organ->opticsId)});
+    }
+    for (const Surface& surface : scene.environment) {
+        out.Add(PlaceMesh(*surface.mesh, glm::dmat4(1.0)),
+                {surface.name, ReceiverKind::kEnvironment, 0, scene.OpticsIndex(surface.opticsId)});
+    }
+    for (std::size_t e = 0; e < scene.sources.emitters.size(); ++e) {
+        const Emitter& emitter = scene.sources.emitters[e];
+        out.Add(PlaceMesh(*emitter.mesh, glm::dmat4(1.0)),
+                {emitter.name, emitter.held ? ReceiverKind::kHeld : ReceiverKind::kEmitter, 0,
+                 emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId),
+                 static_cast<int>(e)});
+    }
+    FlatScene& flat = out.flat;
+    if (out.count == 0) return flat;
+    flat.origin = 0.5 * (out.lo + out.hi);
+    for (Triangle& t : out.triangles) {
+        t.a -= flat.origin;
+        t.b -= flat.origin;
+        t.c -= flat.origin;
+    }
+    flat.boundsMin = out.lo - flat.origin;
+    flat.boundsMax = out.hi - flat.origin;
+    flat.triangles = std::move(out.triangles);
+    return flat;
+}
+
+PlacedOrgans PlacedByFrame(const Scene& scene, std::vector<Triangle>& placed) {
+    return [&placed, worldFromLocal =
+                         WorldFromLocal(scene)](const Node& organ) -> const std::vector<Triangle>& {
+        placed = PlaceMesh(*organ.organ->mesh, worldFromLocal.at(organ.id));
+        return placed;
+    };
 }
 }  // namespace
 
@@ -37,79 +90,32 @@ std::vector<Triangle> PlaceMesh(const Mesh& mesh, const glm::dmat4& worldFromLoc
 }
 
 FlatScene Flatten(const Scene& scene) {
-    const auto worldFromLocal = WorldFromLocal(scene);
     std::vector<Triangle> placed;
-    return Flatten(scene, [&](const Node& organ) -> const std::vector<Triangle>& {
-        placed = PlaceMesh(*organ.organ->mesh, worldFromLocal.at(organ.id));
-        return placed;
-    });
+    return FlattenScene(scene, PlacedByFrame(scene, placed), true);
 }
 
 FlatScene ReceiversOf(const Scene& scene) {
-    FlatScene flat;
-    const auto worldFromLocal = WorldFromLocal(scene);
-    for (const Node& node : scene.nodes) {
-        if (!node.organ) continue;
-        flat.receivers.push_back({scene.NodeName(node), ReceiverKind::kOrgan, node.id,
-                                  scene.OpticsIndex(node.organ->opticsId)});
-        flat.receivers.back().areaM2 = MeshArea(*node.organ->mesh, worldFromLocal.at(node.id));
-    }
-    for (const Surface& surface : scene.environment) {
-        flat.receivers.push_back(
-            {surface.name, ReceiverKind::kEnvironment, 0, scene.OpticsIndex(surface.opticsId)});
-        flat.receivers.back().areaM2 = MeshArea(*surface.mesh, glm::dmat4(1.0));
-    }
-    for (std::size_t e = 0; e < scene.sources.emitters.size(); ++e) {
-        const Emitter& emitter = scene.sources.emitters[e];
-        flat.receivers.push_back(
-            {emitter.name, emitter.held ? ReceiverKind::kHeld : ReceiverKind::kEmitter, 0,
-             emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId),
-             static_cast<int>(e)});
-        flat.receivers.back().areaM2 = MeshArea(*emitter.mesh, glm::dmat4(1.0));
-    }
-    return flat;
+    std::vector<Triangle> placed;
+    return FlattenScene(scene, PlacedByFrame(scene, placed), false);
 }
 
 FlatScene Flatten(const Scene& scene, const PlacedOrgans& placed) {
-    FlatScene flat;
-    std::vector<Triangle> triangles;
+    return FlattenScene(scene, placed, true);
+}
+
+void PlaceOrgans(const Scene& scene, const FlatScene& receivers, float* xyz) {
+    const auto worldFromLocal = WorldFromLocal(scene);
     for (const Node& node : scene.nodes) {
         if (!node.organ) continue;
-        Receiver receiver{scene.NodeName(node), ReceiverKind::kOrgan, node.id,
-                          scene.OpticsIndex(node.organ->opticsId)};
-        AddReceiver(placed(node), std::move(receiver), triangles, flat);
+        for (const Triangle& t : PlaceMesh(*node.organ->mesh, worldFromLocal.at(node.id))) {
+            for (const glm::dvec3& corner : {t.a, t.b, t.c}) {
+                const glm::dvec3 local = corner - receivers.origin;
+                *xyz++ = static_cast<float>(local.x);
+                *xyz++ = static_cast<float>(local.y);
+                *xyz++ = static_cast<float>(local.z);
+            }
+        }
     }
-    for (const Surface& surface : scene.environment) {
-        Receiver receiver{surface.name, ReceiverKind::kEnvironment, 0,
-                          scene.OpticsIndex(surface.opticsId)};
-        AddReceiver(PlaceMesh(*surface.mesh, glm::dmat4(1.0)), std::move(receiver), triangles,
-                    flat);
-    }
-    for (std::size_t e = 0; e < scene.sources.emitters.size(); ++e) {
-        const Emitter& emitter = scene.sources.emitters[e];
-        Receiver receiver{emitter.name, emitter.held ? ReceiverKind::kHeld : ReceiverKind::kEmitter,
-                          0, emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId),
-                          static_cast<int>(e)};
-        AddReceiver(PlaceMesh(*emitter.mesh, glm::dmat4(1.0)), std::move(receiver), triangles,
-                    flat);
-    }
-    if (triangles.empty()) return flat;
-
-    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
-    for (const Triangle& t : triangles) {
-        lo = glm::min(lo, glm::min(t.a, glm::min(t.b, t.c)));
-        hi = glm::max(hi, glm::max(t.a, glm::max(t.b, t.c)));
-    }
-    flat.origin = 0.5 * (lo + hi);
-    for (Triangle& t : triangles) {
-        t.a -= flat.origin;
-        t.b -= flat.origin;
-        t.c -= flat.origin;
-    }
-    flat.boundsMin = lo - flat.origin;
-    flat.boundsMax = hi - flat.origin;
-    flat.triangles = std::move(triangles);
-    return flat;
 }
 
 }  // namespace leaflux

@@ -54,10 +54,13 @@ struct FlatScene {
 // Flattens a validated scene. Receivers come in scene order: organs, environment, emitters.
 FlatScene Flatten(const Scene& scene);
 
-// The receivers Flatten would make, in its order, with their areas, and no triangles: what
-// per-receiver results are indexed by when the scene is never flattened whole (the
-// instanced solver).
+// What Flatten makes but the triangles: the receivers in its order, with their areas and
+// triangle ranges, and the frame (origin, bounds). What per-receiver results are indexed by
+// when the scene is never flattened whole (the instanced solver).
 FlatScene ReceiversOf(const Scene& scene);
+// The organs' triangles as Flatten would place them, straight into 9 floats each, in the
+// frame of `receivers` (ReceiversOf the scene): a ray engine's without the flat scene.
+void PlaceOrgans(const Scene& scene, const FlatScene& receivers, float* xyz);
 
 // A mesh's triangles placed by worldFromLocal, in world coordinates (receiver 0).
 std::vector<Triangle> PlaceMesh(const Mesh& mesh, const glm::dmat4& worldFromLocal);

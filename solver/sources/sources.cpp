@@ -1,8 +1,10 @@
 #include "solver/sources/sources.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <glm/gtc/constants.hpp>
+#include <iterator>
 #include <mutex>
 
 #include "solver/util/check.h"
@@ -57,15 +59,20 @@ double CapIntegralOfAbsZ(const glm::dvec3& axis, double solidAngle) {
 }
 
 // Cells of a discretisation, with their solid angles and centroids integrated over a
-// Fibonacci lattice of the upper hemisphere (low discrepancy: cell solid angles to ~1e-4).
+constexpr SkyModel kSkyModels[] = {SkyModel::kUniform, SkyModel::kCieOvercast};
+
+// A discretisation's cells, integrated over a Fibonacci lattice of the upper hemisphere
+// (low discrepancy: cell solid angles to ~1e-4).
 struct CellIntegration {
     static constexpr int kPoints = 1 << 18;
-    std::vector<int> cellOfPoint;  // per lattice point
-    std::vector<glm::dvec3> pointDirections;
     std::vector<SkyCell> cells;
     // Per cell: the irradiance its cone gives a horizontal plane per unit radiance, ∫ |z|
     // over its cap, the part below the horizon folded up as the solvers fold it.
     std::vector<double> horizontalPerRadiance;
+    // Per sky model, per cell: its cone's radiance under a unit horizontal irradiance (the
+    // model's mean over the cell, renormalised as Sky::Cones says). Radiance is linear in
+    // the horizontal irradiance, so a band's cones are these times its own.
+    std::vector<double> unitRadiance[std::size(kSkyModels)];
 };
 
 CellIntegration Integrate(SkyDiscretization discretization) {
@@ -76,31 +83,41 @@ CellIntegration Integrate(SkyDiscretization discretization) {
                                                                        : -1;
     const DirectionSet* set = level >= 0 ? &DirectionSet::OfLevel(level) : nullptr;
     const int cellCount = set ? set->Size() : 46;
+    constexpr std::size_t kModels = std::size(kSkyModels);
     std::vector<glm::dvec3> sum(cellCount, glm::dvec3(0.0));
     std::vector<int> count(cellCount, 0);
+    std::vector<double> radiance(cellCount * kModels, 0.0);  // Σ over the cell's points
+    std::array<Sky, kModels> unitSkies;
+    for (std::size_t m = 0; m < kModels; ++m) unitSkies[m] = {kSkyModels[m], {1.0}};
     const double golden = kPi * (3.0 - std::sqrt(5.0));
     for (int i = 0; i < CellIntegration::kPoints; ++i) {
         const double z = 1.0 - (i + 0.5) / CellIntegration::kPoints;  // uniform in solid angle
         const double r = std::sqrt(1.0 - z * z);
         const glm::dvec3 d(r * std::cos(golden * i), r * std::sin(golden * i), z);
         const int cell = set ? set->Nearest(d) : TurtleCell(d);
-        result.cellOfPoint.push_back(cell);
-        result.pointDirections.push_back(d);
         sum[cell] += d;
         ++count[cell];
+        for (std::size_t m = 0; m < kModels; ++m)
+            radiance[cell * kModels + m] += unitSkies[m].Radiance(0, d);
     }
-    // Renumber the cells that own part of the upper hemisphere.
-    std::vector<int> renumber(cellCount, -1);
+    // The cells that own part of the upper hemisphere, in order.
+    std::vector<int> owning;
     for (int c = 0; c < cellCount; ++c) {
         if (count[c] == 0) continue;
-        renumber[c] = static_cast<int>(result.cells.size());
+        owning.push_back(c);
         result.cells.push_back(
             {glm::normalize(sum[c]), 2.0 * kPi * count[c] / CellIntegration::kPoints});
-    }
-    for (int& cell : result.cellOfPoint) cell = renumber[cell];
-    for (const SkyCell& cell : result.cells) {
         result.horizontalPerRadiance.push_back(
-            CapIntegralOfAbsZ(cell.direction, cell.solidAngleSr));
+            CapIntegralOfAbsZ(result.cells.back().direction, result.cells.back().solidAngleSr));
+    }
+    for (std::size_t m = 0; m < kModels; ++m) {
+        std::vector<double>& unit = result.unitRadiance[m];
+        double horizontal = 0.0;
+        for (std::size_t k = 0; k < owning.size(); ++k) {
+            unit.push_back(radiance[owning[k] * kModels + m] / count[owning[k]]);
+            horizontal += unit.back() * result.horizontalPerRadiance[k];
+        }
+        for (double& value : unit) value = horizontal > 0.0 ? value / horizontal : 0.0;
     }
     return result;
 }
@@ -192,27 +209,16 @@ std::vector<SkyCell> SkyCells(SkyDiscretization discretization) {
 std::vector<SkyCone> Sky::Cones() const {
     if (discretization == SkyDiscretization::kContinuous) return {};
     const CellIntegration& integration = CellsOf(discretization);
-    const int bands = static_cast<int>(horizontalIrradianceWm2.size());
+    const std::size_t m =
+        std::find(std::begin(kSkyModels), std::end(kSkyModels), model) - std::begin(kSkyModels);
+    LEAFLUX_CHECK(m < std::size(kSkyModels));
     std::vector<SkyCone> cones;
-    for (const SkyCell& cell : integration.cells) {
-        cones.push_back({cell.direction, cell.solidAngleSr, std::vector<double>(bands, 0.0)});
-    }
-    std::vector<int> points(cones.size(), 0);
-    for (std::size_t i = 0; i < integration.cellOfPoint.size(); ++i) {
-        SkyCone& cone = cones[integration.cellOfPoint[i]];
-        ++points[integration.cellOfPoint[i]];
-        for (int b = 0; b < bands; ++b) {
-            cone.radianceWm2Sr[b] += Radiance(b, integration.pointDirections[i]);
-        }
-    }
-    for (int b = 0; b < bands; ++b) {
-        double horizontal = 0.0;
-        for (std::size_t c = 0; c < cones.size(); ++c) {
-            cones[c].radianceWm2Sr[b] /= points[c];
-            horizontal += cones[c].radianceWm2Sr[b] * integration.horizontalPerRadiance[c];
-        }
-        const double scale = horizontal > 0.0 ? horizontalIrradianceWm2[b] / horizontal : 0.0;
-        for (SkyCone& cone : cones) cone.radianceWm2Sr[b] *= scale;
+    for (std::size_t c = 0; c < integration.cells.size(); ++c) {
+        const SkyCell& cell = integration.cells[c];
+        SkyCone cone{cell.direction, cell.solidAngleSr, {}};
+        for (double horizontal : horizontalIrradianceWm2)
+            cone.radianceWm2Sr.push_back(horizontal * integration.unitRadiance[m][c]);
+        cones.push_back(std::move(cone));
     }
     return cones;
 }
