@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "solver/generate/generator.h"
+#include "solver/util/sampling.h"
 #include "tests/scene_builders.h"
 
 namespace leaflux {
@@ -120,6 +122,70 @@ TEST(RayScene, WrapsAroundAPeriodicTile) {
               RayFate::kEscapedUp);
     EXPECT_FALSE(
         rays.Occluded({flat.ToLocal({0.5, 0.1, 0.5})}, glm::normalize(glm::dvec3(0, 1, 0.1))));
+}
+
+TEST(RayScene, OrgansPlacedStraightInTraceAsTheFlatScenesOrgans) {
+    // A tree of placed frames over a ground: the organs written straight into the engine
+    // from the scene (the instanced solver's shadows) against the flat scene's first
+    // triangles, ray by ray, and the receivers without triangles against Flatten's.
+    Scene scene = OneBandScene({{"leaf", Leaf(0.1, 0.05)}, {"stem", Opaque(0.2)}});
+    TreeParameters tree;
+    tree.leafCount = 200;
+    AddTree(scene, tree, {40.0, -7.0, 0.0});
+    scene.environment.push_back({"ground", Rectangle(6.0, 6.0, 0.0), "stem"});
+    scene.Validate();
+    const FlatScene flat = Flatten(scene);
+    const FlatScene receivers = ReceiversOf(scene);
+    ASSERT_TRUE(receivers.triangles.empty());
+    ASSERT_EQ(receivers.receivers.size(), flat.receivers.size());
+    std::uint32_t organTriangles = 0;
+    for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
+        const Receiver &a = receivers.receivers[r], &b = flat.receivers[r];
+        EXPECT_EQ(a.name, b.name);
+        EXPECT_EQ(a.kind, b.kind);
+        EXPECT_EQ(a.firstTriangle, b.firstTriangle);
+        EXPECT_EQ(a.triangleCount, b.triangleCount);
+        EXPECT_EQ(a.areaM2, b.areaM2);
+        if (b.kind == ReceiverKind::kOrgan) organTriangles += b.triangleCount;
+    }
+    EXPECT_EQ(receivers.origin, flat.origin);
+    EXPECT_EQ(receivers.boundsMin, flat.boundsMin);
+    EXPECT_EQ(receivers.boundsMax, flat.boundsMax);
+    ASSERT_LT(organTriangles, flat.triangles.size());  // the ground is not among them
+
+    const RayScene whole(flat, std::nullopt);
+    const std::unique_ptr<RayScene> organs = OrganRays(scene, receivers);
+    Random random(7);
+    int hits = 0, blocked = 0;
+    for (int i = 0; i < 4000; ++i) {
+        // From a point of an organ triangle, or from a point in the crown, any way.
+        const std::uint32_t t = static_cast<std::uint32_t>(random.Uniform() * organTriangles);
+        const Triangle& tri = flat.triangles[t];
+        const double u = random.Uniform(), v = random.Uniform() * (1.0 - u);
+        RayStart start{tri.a + u * (tri.b - tri.a) + v * (tri.c - tri.a), t};
+        if (i % 2 == 1)
+            start = {start.origin + 0.05 * glm::dvec3(random.Uniform() - 0.5,
+                                                      random.Uniform() - 0.5,
+                                                      random.Uniform() - 0.5)};
+        const double z = 2.0 * random.Uniform() - 1.0, phi = 2.0 * kPi * random.Uniform();
+        const double s = std::sqrt(1.0 - z * z);
+        const glm::dvec3 direction(s * std::cos(phi), s * std::sin(phi), z);
+        const bool byOrgans = organs->Occluded(start, direction);
+        EXPECT_EQ(byOrgans, whole.OccludedByFirst(start, direction, INFINITY, organTriangles))
+            << "ray " << i;
+        blocked += byOrgans;
+        const RayHit hit = organs->Trace(start, direction);
+        hits += hit.fate == RayFate::kHit;
+        // Where the flat scene's first hit is an organ's, the same triangle as far.
+        if (const RayHit first = whole.Trace(start, direction);
+            first.fate == RayFate::kHit && first.triangle < organTriangles) {
+            EXPECT_EQ(hit.triangle, first.triangle) << "ray " << i;
+            EXPECT_EQ(hit.distance, first.distance) << "ray " << i;
+        }
+    }
+    EXPECT_GT(blocked, 100);
+    EXPECT_LT(blocked, 3900);
+    EXPECT_EQ(hits, blocked);
 }
 
 }  // namespace

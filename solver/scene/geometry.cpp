@@ -4,8 +4,8 @@
 
 namespace leaflux {
 namespace {
-// Appends a receiver of the placed triangles: its area and triangle range, and the
-// triangles themselves when `triangles` is kept (else only their count and bounds).
+// Flatten's receivers as their triangles are added: each one's area and triangle range, the
+// bounds, and the triangles themselves when `keep` is set.
 struct Flattening {
     FlatScene flat;
     bool keep = true;
