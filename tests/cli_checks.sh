@@ -5,7 +5,8 @@
 # scene that cannot fit in memory at once, with its estimate, and options its kind of scene
 # ignores; leaflux-grow's --ply-cycles and stand options; solve's CSV in W and µmol; client
 # cycle --out writes the Python package's CSV, in W and µmol (empty for a band without a
-# photon unit), and prints a summary; the example scripts run as they are and answer --help.
+# photon unit), and prints a summary; the example scripts run as they are and answer --help;
+# solve --ply writes the scene's triangles with every solver.
 # Usage: cli_checks.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
 leaflux=$1/server/leaflux
@@ -91,6 +92,19 @@ w, umol = float(leaf["irradiance_upper_wm2"]), float(leaf["photon_irradiance_upp
 assert w > 100 and abs(umol - 4.57 * w) < 1e-6 * umol, (w, umol)
 assert abs(float(leaf["absorbed_umol_s"]) - 4.57 * float(leaf["absorbed_w"])) < 1e-9 + 1e-6 * float(leaf["absorbed_umol_s"])
 PY
+
+# --ply holds the scene's triangles whichever solver lit them (the instanced solver's
+# receivers carry none of their own).
+"$leaflux" generate --leaves 40 --out "$out/t40.scene.txtpb" > /dev/null
+faces() { grep -m1 "^element face" "$1" | cut -d' ' -f3; }
+"$leaflux" solve --scene "$out/t40.scene.txtpb" --quiet --solver hrc --out "$out/h.csv" \
+    --ply "$out/h.ply" > /dev/null
+for shadows in geometry transmittance; do
+    "$leaflux" solve --scene "$out/t40.scene.txtpb" --quiet --solver instanced --no-phase-db \
+        --shadows "$shadows" --out "$out/i.csv" --ply "$out/i.ply" > /dev/null
+    [ "$(faces "$out/i.ply")" = "$(faces "$out/h.ply")" ] && [ "$(faces "$out/h.ply")" -gt 0 ] ||
+        fail "instanced --ply ($shadows): $(faces "$out/i.ply") faces, hrc $(faces "$out/h.ply")"
+done
 
 # leaflux-grow: a sentence for a bad cycle list; a stand's options on a scenario without one.
 refused "$grow" --scenario "$source/growth_stub/scenarios/stand.txtpb" --ply-cycles 2,x \
