@@ -288,15 +288,7 @@ TEST(Instanced, LightPerAxisOpensAPlantWhoseAxesAreNoInstances) {
     EXPECT_EQ(perAxis.stats.depths[1].opened, 2);
     EXPECT_EQ(perAxis.stats.depths[1].whole, 0);
     EXPECT_TRUE(perAxis.solution.wholeStructures.empty());
-    ASSERT_EQ(perAxis.solution.light.size(), perLeaf.solution.light.size());
-    for (std::size_t r = 0; r < perLeaf.solution.light.size(); ++r) {
-        for (std::size_t b = 0; b < scene.bands.size(); ++b) {
-            EXPECT_EQ(perAxis.solution.light[r][b].irradianceUpperWm2,
-                      perLeaf.solution.light[r][b].irradianceUpperWm2);
-            EXPECT_EQ(perAxis.solution.light[r][b].absorbedW,
-                      perLeaf.solution.light[r][b].absorbedW);
-        }
-    }
+    testing::ExpectIdenticalLight(perAxis.solution, perLeaf.solution);
     int axes = 0;
     for (const StructureLight& s : AggregateStructures(scene, prepared.Flat(), perAxis.solution)) {
         if (s.type != NodeType::kAxis) continue;
@@ -480,15 +472,7 @@ TEST(Instanced, OneCoreGivesTheLightOfEvery) {
     // One core used: no more CPU time than wall time, within the clocks' ticks (on two,
     // 1.7 times as much).
     EXPECT_LE(one.solution.stats.cpuSeconds, 1.05 * one.solution.stats.wallSeconds + 0.02);
-    ASSERT_EQ(one.solution.light.size(), two.solution.light.size());
-    for (std::size_t r = 0; r < one.solution.light.size(); ++r) {
-        for (std::size_t b = 0; b < scene.bands.size(); ++b) {
-            EXPECT_EQ(one.solution.light[r][b].irradianceUpperWm2,
-                      two.solution.light[r][b].irradianceUpperWm2);
-            EXPECT_EQ(one.solution.light[r][b].irradianceLowerWm2,
-                      two.solution.light[r][b].irradianceLowerWm2);
-        }
-    }
+    testing::ExpectIdenticalLight(one.solution, two.solution);
 }
 
 // The energy balance closes: what the suns and sky bring is absorbed or escapes, counting

@@ -119,4 +119,21 @@ inline void ExpectFiniteLight(const Solution& solution) {
     }
 }
 
+// Two solutions give every receiver the same light, to the last bit: irradiance on each
+// side and absorbed power, in every band.
+inline void ExpectIdenticalLight(const Solution& a, const Solution& b) {
+    ASSERT_EQ(a.light.size(), b.light.size());
+    for (std::size_t r = 0; r < a.light.size(); ++r) {
+        ASSERT_EQ(a.light[r].size(), b.light[r].size()) << "receiver " << r;
+        for (std::size_t k = 0; k < a.light[r].size(); ++k) {
+            EXPECT_EQ(a.light[r][k].irradianceUpperWm2, b.light[r][k].irradianceUpperWm2)
+                << "receiver " << r << ", band " << k;
+            EXPECT_EQ(a.light[r][k].irradianceLowerWm2, b.light[r][k].irradianceLowerWm2)
+                << "receiver " << r << ", band " << k;
+            EXPECT_EQ(a.light[r][k].absorbedW, b.light[r][k].absorbedW)
+                << "receiver " << r << ", band " << k;
+        }
+    }
+}
+
 }  // namespace leaflux::testing
