@@ -175,8 +175,9 @@ int RunSolve(const SolveCommand& command) {
     if (!command.ply.empty()) {
         std::ofstream ply(command.ply);
         if (!ply) throw InputError(ErrorCode::kIo, command.ply, "cannot write");
-        // The instanced solver's receivers hold no triangles.
-        WritePly(ply, flat.triangles.empty() ? Flatten(scene) : flat, solution, 0);
+        // The instanced solver's receivers hold no triangles: the scene flattened for it.
+        const FlatScene whole = flat.triangles.empty() ? Flatten(scene) : FlatScene{};
+        WritePly(ply, flat.triangles.empty() ? whole : flat, solution, 0);
     }
     std::cout << Summary(command.solver, scene, flat, solution) << std::endl;
     for (const LinkAudit& audit : solution.linkAudit) {

@@ -41,7 +41,7 @@ struct SolvedScene {
     Scene scene;
     std::optional<PreparedScene> prepared;
     FlatScene receivers;
-    std::unique_ptr<RayScene> shadows;
+    std::unique_ptr<RayScene> shadows;  // refers to `receivers`, declared before it
     Solution solution;
 
     const FlatScene& Flat() const { return prepared ? prepared->Flat() : receivers; }
