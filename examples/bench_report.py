@@ -251,12 +251,14 @@ def bench_rows(build, out, program, name, run):
 
 def daemon_section(build, out, run=True):
     """Runs leaflux_bench_daemon: the median solve of a cycle of the growing plants, by solver,
-    database and ε."""
+    database, start of the iteration and ε."""
     rows = bench_rows(build, out, "leaflux_bench_daemon", "daemon_bench.csv", run)
-    names = {"growing_tree": "HRC", "instanced_cold": "instanced, empty database",
-             "instanced_warm": "instanced, the database filled"}
-    table = ["| solver | leaves | ε | median solve ms (10 cycles) | last cycle ms | phase functions computed |",
-             "|---|---|---|---|---|---|"]
+    names = {"growing_tree": "HRC", "growing_tree_warm_start": "HRC, warm start",
+             "instanced_cold": "instanced, empty database",
+             "instanced_warm": "instanced, the database filled",
+             "instanced_warm_start": "instanced, the database filled, warm start"}
+    table = ["| solver | leaves | ε | median solve ms (10 cycles) | last cycle ms | sweeps (10 cycles) | "
+             "phase functions computed |", "|---|---|---|---|---|---|---|"]
     keys = []
     for r in rows:
         key = (r["what"], r["leaves"], r["epsilon"])
@@ -266,7 +268,8 @@ def daemon_section(build, out, run=True):
         cycle = [r for r in rows if (r["what"], r["leaves"], r["epsilon"]) == (what, leaves, epsilon)]
         solve = median(float(r["solve_ms"]) for r in cycle)
         table.append(f"| {names[what]} | {int(leaves):,} | {float(epsilon):.0e} | {number(solve)} | "
-                     f"{number(cycle[-1]['solve_ms'])} | {sum(int(r['phase_computed']) for r in cycle)} |")
+                     f"{number(cycle[-1]['solve_ms'])} | {sum(int(r['iterations']) for r in cycle)} | "
+                     f"{sum(int(r['phase_computed']) for r in cycle)} |")
     return "\n".join(table)
 
 
@@ -354,11 +357,13 @@ DAEMON_GOAL_PCT = 2.0  # the L2 error a cycle is asked to stay within, per band
 
 
 def daemon_accuracy_section(build, out, run=True):
-    """`leaflux bench error` on the daemon's trees at the ε of its cycles (HRC only): how much
-    accuracy each ε costs, and the coarsest ε within DAEMON_GOAL_PCT in every band."""
+    """`leaflux bench error` on the daemon's trees at the ε of its cycles, HRC and the
+    instanced solver (from the database its cold run filled): how much accuracy each ε
+    costs, and the coarsest ε within DAEMON_GOAL_PCT in every band."""
     leaflux = os.path.join(build, "server", "leaflux")
-    table = ["| tree | " + " | ".join(f"ε = {e}: L2 % of max, by band" for e in DAEMON_EPSILONS) + " |",
-             "|---|" + "---|" * len(DAEMON_EPSILONS)]
+    solvers = {"hrc": "HRC", "instanced": "instanced"}
+    table = ["| tree | solver | " + " | ".join(f"ε = {e}: L2 % of max, by band" for e in DAEMON_EPSILONS) + " |",
+             "|---|---|" + "---|" * len(DAEMON_EPSILONS)]
     coarsest = []
     for name, leaves in DAEMON_TREES:
         if run:
@@ -368,19 +373,25 @@ def daemon_accuracy_section(build, out, run=True):
                             "--out", scene], check=True, capture_output=True)
             subprocess.run([leaflux, "bench", "error", "--scene", scene, "--name", name, "--out", out,
                             "--cache", os.path.join(out, "cache"), "--no-mc", "--no-direct", "--no-plot",
-                            "--hrc-epsilon", ",".join(DAEMON_EPSILONS)], check=True)
+                            "--hrc-epsilon", ",".join(DAEMON_EPSILONS),
+                            "--instanced-epsilon", ",".join(DAEMON_EPSILONS)], check=True)
             shutil.copy(os.path.join(out, f"{name}.csv"), os.path.join(REPORT, f"daemon_accuracy_{name}.csv"))
         rows = list(csv.DictReader(open(os.path.join(REPORT, f"daemon_accuracy_{name}.csv"))))
-        cells, within = [], None
-        for epsilon in DAEMON_EPSILONS:
-            at = [r for r in rows if r["solver"] == "hrc" and r["setting"].startswith("epsilon=")
-                  and float(r["setting"].split("=")[1]) == float(epsilon)]
-            cells.append(" / ".join(f"{r['band']} {number(r['l2_pct_of_max'])}" for r in at))
-            if all(float(r["l2_pct_of_max"]) <= DAEMON_GOAL_PCT for r in at):
-                within = epsilon
-        table.append(f"| {leaves:,} leaves | " + " | ".join(cells) + " |")
-        coarsest.append(f"{within} for the {leaves:,}-leaf plant" if within
-                        else f"none of these for the {leaves:,}-leaf plant")
+        for solver, label in solvers.items():
+            cells, within = [], None
+            for epsilon in DAEMON_EPSILONS:
+                # The plain run at this ε (not the variants beside it: cold, phase=bi, ...).
+                at = [r for r in rows if r["solver"] == solver and r["setting"].startswith("epsilon=")
+                      and " " not in r["setting"] and float(r["setting"].split("=")[1]) == float(epsilon)]
+                if not at:
+                    cells.append("–")
+                    continue
+                cells.append(" / ".join(f"{r['band']} {number(r['l2_pct_of_max'])}" for r in at))
+                if all(float(r["l2_pct_of_max"]) <= DAEMON_GOAL_PCT for r in at):
+                    within = epsilon
+            table.append(f"| {leaves:,} leaves | {label} | " + " | ".join(cells) + " |")
+            coarsest.append(f"{within} for the {leaves:,}-leaf plant with {label}" if within
+                            else f"none of these for the {leaves:,}-leaf plant with {label}")
     table += ["", f"The coarsest ε whose cycles stay within {DAEMON_GOAL_PCT:g} % L2 in every band: "
               + "; ".join(coarsest) + " (their times are in the daemon's tables above)."]
     return "\n".join(table)

@@ -217,7 +217,9 @@ v1::CycleResult Session::Run(const v1::Cycle& cycle) {
                            "the session would hold " + std::to_string(store_.Get().nodes.size()) +
                                " nodes; at most " + std::to_string(limits_.maxNodes));
         }
-        result = Solve(cycle.outputs());
+        Solved solved = Solve(cycle.outputs());
+        result = std::move(solved.result);
+        if (solved.warm) warm_ = std::move(solved.warm);
     } catch (...) {
         store_.Undo();
         throw;
@@ -250,7 +252,7 @@ SceneChange Session::Change(const v1::Cycle& cycle) const {
     return change;
 }
 
-v1::CycleResult Session::Solve(const v1::OutputRequest& outputs) const {
+Session::Solved Session::Solve(const v1::OutputRequest& outputs) const {
     const Scene& scene = store_.Get();
     std::vector<int> wanted;
     for (const std::string& band : outputs.bands()) {
@@ -277,6 +279,9 @@ v1::CycleResult Session::Solve(const v1::OutputRequest& outputs) const {
     const bool lightVectors = !outputs.has_light_vectors() || outputs.light_vectors();
     SolverSettings settings = solver_.settings;
     settings.hrc.lightVectors = lightVectors;
+    // Its bands as the last cycle's: the iteration starts from their light.
+    const bool warm = solver_.warmStart && allBands && settings.kind != SolverKind::kMonteCarlo;
+    if (warm) settings.hrc.warmStart = warm_;
     Clock::time_point start = Clock::now();
     FlatScene flat = store_.Flat();
     CheckPeriodicTile(scene, flat, limits_);
@@ -298,8 +303,11 @@ v1::CycleResult Session::Solve(const v1::OutputRequest& outputs) const {
     } else {
         solution = leaflux::Solve(prepared, settings);
     }
-    spdlog::debug("solved in {:.1f} ms", Milliseconds(start));
-    v1::CycleResult result;
+    spdlog::debug("solved in {:.1f} ms ({} organs from the last cycle's light)",
+                  Milliseconds(start), solution.stats.warmOrgans);
+    Solved out;
+    if (warm) out.warm = std::make_shared<const WarmStart>(prepared.Flat().receivers, solution);
+    v1::CycleResult& result = out.result;
     if (outputs.leaves()) {
         for (std::size_t r = 0; r < prepared.Flat().receivers.size(); ++r) {
             // Organs inside a structure solved whole have no light of their own.
@@ -332,6 +340,7 @@ v1::CycleResult Session::Solve(const v1::OutputRequest& outputs) const {
     stats->set_elements(solution.stats.elements);
     stats->set_iterations(solution.stats.iterations);
     stats->set_residual(solution.stats.residual);
+    stats->set_warm_organs(solution.stats.warmOrgans);
     stats->set_threads(solution.stats.threads);
     if (instanced) {
         int opened = 0;
@@ -351,7 +360,7 @@ v1::CycleResult Session::Solve(const v1::OutputRequest& outputs) const {
         balance->set_absorbed_w(solution.balance[b].absorbedW);
         balance->set_escaped_w(solution.balance[b].escapedW);
     }
-    return result;
+    return out;
 }
 
 Daemon::Daemon(DaemonLimits limits, DaemonPhaseFunctions phase)
@@ -471,6 +480,7 @@ SessionSolver Daemon::Settings(const v1::SolverSettings& in, const std::string& 
         threads = threads == 0 ? limits_.solverThreads : std::min(threads, limits_.solverThreads);
         settings.monteCarlo.threads = threads;
     }
+    solver.warmStart = in.warm_start();
     if (in.solver() == v1::SOLVER_KIND_INSTANCED) {
         solver.instanced = InstancedRunFromProto(in.instanced(), species, phase_.policyDir);
         solver.database = phaseDb_;

@@ -46,6 +46,7 @@ struct DaemonPhaseFunctions {
 // the daemon's database.
 struct SessionSolver {
     SolverSettings settings;
+    bool warmStart = false;  // from the last cycle's light (SolverSettings.warm_start)
     std::optional<InstancedRun> instanced;
     std::shared_ptr<PhaseDatabase> database;  // set with `instanced`
 };
@@ -78,7 +79,11 @@ class Session {
 
   private:
     SceneChange Change(const v1::Cycle& cycle) const;
-    v1::CycleResult Solve(const v1::OutputRequest& outputs) const;
+    struct Solved {
+        v1::CycleResult result;
+        std::shared_ptr<const WarmStart> warm;  // its organs' light, when every band was solved
+    };
+    Solved Solve(const v1::OutputRequest& outputs) const;
 
     void Count();
 
@@ -90,6 +95,8 @@ class Session {
     // changes nothing: the solvers are deterministic, so it would get the same light.
     std::string lastOutputs_;
     std::optional<v1::CycleResult> last_;
+    // The organs' light of the last cycle that solved every band: where the next starts.
+    std::shared_ptr<const WarmStart> warm_;
     std::atomic<std::int64_t> cycles_{0}, lastCycle_{0};
     std::atomic<int> nodes_{0}, organs_{0};
 };

@@ -7,11 +7,13 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
 
 #include "server/cli_checks.h"
 #include "server/progress.h"
 #include "server/scene_proto.h"
 #include "solver/results/export.h"
+#include "solver/results/read_leaf_csv.h"
 #include "solver/util/error.h"
 #include "solver/util/memory.h"
 
@@ -99,6 +101,13 @@ CLI::App* AddSolveCommand(CLI::App& app, SolveCommand& command) {
                       "Per-structure CSV (plants, axes, phytomers)");
     solve->add_option("--ply", command.ply,
                       "PLY of the triangles with the first band's irradiance");
+    solve
+        ->add_option("--warm-start", command.warmStart,
+                     "hrc, instanced: start the iteration from the organs' light in this "
+                     "per-organ CSV of an earlier solve (by organ name, as --out writes it; "
+                     "the last growth cycle's): the same light within the iteration's "
+                     "tolerance and the links' epsilon, in fewer sweeps where little changed")
+        ->check(CLI::ExistingFile);
     return solve;
 }
 
@@ -133,6 +142,10 @@ std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
     settings.hrc.epsilon = command.epsilon;
     settings.hrc.threads = command.threads;
     settings.monteCarlo.directOnly = settings.hrc.directOnly = command.directOnly;
+    if (!command.warmStart.empty()) {
+        settings.hrc.warmStart = std::make_shared<const WarmStart>(
+            flat.receivers, ReadLeafCsv(command.warmStart, scene, flat));
+    }
     if (!command.quiet) {
         spdlog::info(
             "{}: {} receivers, {} triangles, {} bands; loaded in {:.2f} s", command.scene,

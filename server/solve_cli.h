@@ -18,6 +18,7 @@ namespace leaflux {
 
 struct SolveCommand {
     std::string scene, solver = "hrc", out, structures, ply;
+    std::string warmStart;  // a per-organ CSV of an earlier solve: where the iteration starts
     int samples = 1024, replicates = 16, threads = 0;
     double epsilon = 1e-4;
     HrcOptions hrc;  // subdivision, rays and directions; ε and threads are set apart

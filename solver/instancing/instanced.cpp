@@ -326,6 +326,7 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     if (p != InstanceTree::kTop) ++out_.stats.depths[size.depth].opened;
     Solution& solution = out_.solution;
     solution.stats.rays += light.solution.stats.rays;
+    solution.stats.warmOrgans += light.solution.stats.warmOrgans;
     solution.stats.links = std::max(solution.stats.links, light.solution.stats.links);
     solution.stats.elements = std::max(solution.stats.elements, light.solution.stats.elements);
     solution.stats.iterations =

@@ -98,7 +98,7 @@ std::vector<NodeLink> HeldAroundLinks(
     // r's points, spread over its area (in the sender's frame).
     std::vector<Hierarchy::Point> at;
     std::vector<glm::dvec3> points;
-    for (int i = 0; i < kCells; ++i) {  // a ray each per direction bin
+    for (int i = 0; i < kCells; ++i) {
         for (int j = 0; j < kCells; ++j) {
             at.push_back(hierarchy.Sample(r, (i + 0.5) / kCells, (j + 0.5) / kCells));
             points.emplace_back(instanceFromScene * glm::dvec4(at.back().position, 1.0));
@@ -109,7 +109,10 @@ std::vector<NodeLink> HeldAroundLinks(
         const glm::dvec3& omega = directions.Direction(d);  // the way the light goes
         const glm::dvec3 back = linear * -omega;            // towards where it comes from
         double behind = 0.0;  // the mean ℓ (m), as far as seen from the point
-        for (std::size_t i = 0; i < points.size(); ++i) {
+        // A point of each row of r's grid, in a column that turns with the bin: each bin
+        // sees r's whole extent, and the bins together every point.
+        for (int row = 0; row < kCells; ++row) {
+            const std::size_t i = row * kCells + (row + d) % kCells;
             const BoxSpan span = LineThroughBox(points[i], back, sender.boxMin, sender.boxMax);
             if (!span.Meets() || span.exit <= 0.0) continue;
             const double from = std::max(span.enter, 0.0), length = span.exit - from;
@@ -117,7 +120,7 @@ std::vector<NodeLink> HeldAroundLinks(
             ++rays;
             behind += length * passed(at[i], -omega, from + 0.5 * length);
         }
-        behind /= static_cast<double>(points.size());
+        behind /= static_cast<double>(kCells);
         if (behind <= 0.0) continue;
         NodeLink link;
         link.sender = s;

@@ -208,15 +208,20 @@ class SceneSolve {
                            [](const ClosedNode& c) { return c.Held(); });
     }
     // Direct light first, so that links are refined on what senders will send: the sources
-    // pushed down, one update and a pull-up.
+    // pushed down, one update and a pull-up (from a warm start, the light it had).
     void LightFromSources() {
         pushPull_.PushSources(*active_, sources_, sourceLight_, Closed());
         if (!options_.directOnly) {
             pushPull_.PushDown<false>(*active_, gathered_, sourceLight_, leafLight_, Closed());
+            WarmLeaves();
             Update();
         }
         pushPull_.PullUp(field_);
     }
+    // The leaf patches of the organs HrcOptions::warmStart has: on the first arrival they
+    // hold, the light their organ had there beyond its first arrival (the light scattered
+    // onto it, its mean). Returns how many organs it had.
+    std::int64_t WarmLeaves();
     // Jacobi from the emission, then refine–solve passes until no link needs refining.
     void Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock);
     ClosedLight* Closed() { return hierarchy_.Closed().empty() ? nullptr : &closedLight_; }
@@ -424,6 +429,52 @@ void SceneSolve::Solve(Solution& solution) {
         rays() - sourceRays - refineRays - passRays);
 }
 
+std::int64_t SceneSolve::WarmLeaves() {
+    const WarmStart* warm = options_.warmStart.get();
+    if (warm == nullptr || options_.directOnly || channels_.beams != 1 ||
+        warm->Bands() != channels_.bands)
+        return 0;
+    // What the first arrival (the sources', lamps' and held senders' light, just gathered)
+    // brings each organ on average: the earlier light less it is what was scattered onto the
+    // organ. The first arrival stays each patch's own (sun and shade on a leaf); the
+    // scattered light is spread evenly, so that the first sweeps still even it out where a
+    // neighbour leaf lies close (the 10,000-leaf tree, warm from its own solution: the first
+    // change 13 % of the largest radiosity, against 26 % from the direct light).
+    const int sides = 2 * channels_.bands;
+    std::vector<double> first(flat_.receivers.size() * sides, 0.0), area(flat_.receivers.size());
+    const std::vector<std::uint32_t>& leaves = traversal_.Leaves();
+    for (std::uint32_t n : leaves) {
+        const std::uint32_t r = hierarchy_[n].receiver;
+        if (flat_.receivers[r].kind != ReceiverKind::kOrgan) continue;
+        const double a = hierarchy_[n].areaM2;
+        area[r] += a;
+        for (int b = 0; b < channels_.bands; ++b) {
+            first[r * sides + 2 * b] += a * leafLight_.irradiance(n, kUpper)[b];
+            first[r * sides + 2 * b + 1] += a * leafLight_.irradiance(n, kLower)[b];
+        }
+    }
+    std::int64_t found = 0;
+    for (std::uint32_t r = 0; r < flat_.receivers.size(); ++r) {
+        const float* light = area[r] > 0.0 ? warm->Of(flat_.receivers[r].node) : nullptr;
+        if (light == nullptr) {
+            area[r] = 0.0;
+            continue;
+        }
+        ++found;
+        for (int k = 0; k < sides; ++k)
+            first[r * sides + k] = std::max(0.0, light[k] - first[r * sides + k] / area[r]);
+    }
+    for (std::uint32_t n : leaves) {
+        const std::uint32_t r = hierarchy_[n].receiver;
+        if (area[r] <= 0.0) continue;
+        for (int b = 0; b < channels_.bands; ++b) {
+            leafLight_.irradiance(n, kUpper)[b] += first[r * sides + 2 * b];
+            leafLight_.irradiance(n, kLower)[b] += first[r * sides + 2 * b + 1];
+        }
+    }
+    return found;
+}
+
 void SceneSolve::Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock) {
     // Jacobi from the emission: the first sweep's light is the direct light. Then the links
     // are judged again with the light of the solution and the iteration goes on from it,
@@ -463,6 +514,7 @@ void SceneSolve::Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock)
             } else {
                 Collect<false>();
             }
+            std::int64_t warmed = 0;
             if (iteration == 0) {
                 leafLight_.direct = leafLight_.irradiance;
                 // Light that arrived on an opened instance from the rest of the scene, or
@@ -472,10 +524,18 @@ void SceneSolve::Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock)
                     std::any_of(sources_.begin(), sources_.end(),
                                 [](const DirectionalSource& s) { return !s.incident; }))
                     leafLight_.direct = sourceLight_.incident;
+                warmed = WarmLeaves();
+                solution.stats.warmOrgans = warmed;
             }
             residual = options_.directOnly ? UpdateRadiosity(hierarchy_, traversal_.Leaves(),
                                                              optics_, leafLight_, field_)
                                            : Update();
+            if (warmed > 0) {
+                // The jump to the warm start is no step of the geometric series of changes
+                // that the convergence extrapolates.
+                pushPull_.PullUp(field_);
+                continue;
+            }
             if (const double factor = convergence.Step(residual); factor > 0.0) {
                 Extrapolate(traversal_.Leaves(), leafLight_, factor, field_);
                 ++solution.stats.extrapolations;

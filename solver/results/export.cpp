@@ -120,6 +120,7 @@ std::string Summary(const std::string& solver, const Scene& scene, const FlatSce
         text << ", " << stats.links << " links, " << stats.elements << " elements, "
              << stats.refinementDepth << " levels, " << stats.iterations << " iterations, residual "
              << Number(stats.residual);
+        if (stats.warmOrgans > 0) text << " (" << stats.warmOrgans << " organs warm-started)";
     }
     for (std::size_t b = 0; b < solution.balance.size(); ++b) {
         const EnergyBalance& e = solution.balance[b];

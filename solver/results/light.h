@@ -59,8 +59,9 @@ struct SolveStats {
     std::int64_t elements = 0;
     int refinementDepth = 0;  // deepest level of the hierarchy that links reach
     int iterations = 0;
-    int extrapolations = 0;  // jumps that accelerated the iteration
-    double residual = 0.0;   // relative change of the radiosity still to come
+    int extrapolations = 0;       // jumps that accelerated the iteration
+    std::int64_t warmOrgans = 0;  // organs whose iteration started from a warm start
+    double residual = 0.0;        // relative change of the radiosity still to come
 };
 
 // Wall and CPU time and peak memory of a solve, from its start to Stamp.

@@ -2,10 +2,11 @@
 // empty delta, answered with the last cycle's light — with the organs' results or none —
 // or solved again when it asks other outputs) and the latency of cycles of a plant growing to
 // 1,000 leaves (HRC, ε = 1e-4, 3e-4 and 1e-3) and 10,000 leaves (ε = 1e-4 and 3e-4), one
-// tenth of the plant added per cycle; and the same plants with the instanced solver
-// (ε = 1e-4 and 3e-4), first on a new daemon's empty phase-function database (cold: the
-// functions computed as the plant's structures appear), then as a second session on the
-// database the first filled (warm: none computed).
+// tenth of the plant added per cycle, each grown twice: from the direct light, and from the
+// last cycle's light (SolverSettings.warm_start); and the same plants with the instanced
+// solver, first on a new daemon's empty phase-function database (cold: the functions
+// computed as the plant's structures appear), then as a second session on the database the
+// first filled (warm: none computed), then a third on it with the warm start.
 // Run: build/release/tests/leaflux_bench_daemon [out.csv, default out/bench/daemon_bench.csv]
 #include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
@@ -91,6 +92,8 @@ struct Row {
     int cycle, organs;
     double roundTripMs, solveMs;
     int phaseComputed = 0;
+    int iterations = 0;
+    std::int64_t warmOrgans = 0;
 };
 
 }  // namespace
@@ -137,7 +140,8 @@ int main(int argc, char** argv) {
             const v1::SolveStatistics& stats = reply.cycle().statistics();
             rows.push_back({what, leaves, settings.epsilon(), c, reply.cycle().organs_size(),
                             1e3 * Seconds(start), 1e3 * stats.wall_seconds(),
-                            stats.phase_functions_computed()});
+                            stats.phase_functions_computed(), stats.iterations(),
+                            stats.warm_organs()});
         }
         return session;
     };
@@ -145,6 +149,9 @@ int main(int argc, char** argv) {
          {std::pair{1000, 1e-4}, {1000, 3e-4}, {1000, 1e-3}, {10000, 1e-4}, {10000, 3e-4}}) {
         v1::SolverSettings settings;
         settings.set_epsilon(epsilon);
+        settings.set_warm_start(true);
+        grow(daemon, "growing_tree_warm_start", leaves, settings);
+        settings.set_warm_start(false);
         const std::string session = grow(daemon, "growing_tree", leaves, settings);
         // The same plant again with nothing changed. Asking what the last cycle asked, its
         // light comes back unsolved: the protocol alone and the organs' results (median of
@@ -175,28 +182,33 @@ int main(int argc, char** argv) {
         unchanged(false, kRepeats, "empty_nothing");
     }
     for (const auto& [leaves, epsilon] :
-         {std::pair{1000, 1e-4}, {1000, 3e-4}, {10000, 1e-4}, {10000, 3e-4}}) {
+         {std::pair{1000, 1e-4}, {1000, 3e-4}, {1000, 1e-3}, {10000, 1e-4}, {10000, 3e-4}}) {
         v1::SolverSettings settings;
         settings.set_solver(v1::SOLVER_KIND_INSTANCED);
         settings.set_epsilon(epsilon);
         Loopback fresh;  // its database empty
         grow(fresh, "instanced_cold", leaves, settings);
         grow(fresh, "instanced_warm", leaves, settings);
+        settings.set_warm_start(true);
+        grow(fresh, "instanced_warm_start", leaves, settings);
     }
     const char* path = argc > 1 ? argv[1] : "out/bench/daemon_bench.csv";
     if (const auto folder = std::filesystem::path(path).parent_path(); !folder.empty())
         std::filesystem::create_directories(folder);  // out/ from the checkout root
     std::ofstream csv(path);
-    csv << "what,leaves,epsilon,cycle,organs,round_trip_ms,solve_ms,overhead_ms,phase_computed\n";
-    std::printf("%-14s %7s %8s %6s %7s %14s %10s %12s %6s\n", "what", "leaves", "epsilon", "cycle",
-                "organs", "round_trip_ms", "solve_ms", "overhead_ms", "phases");
+    csv << "what,leaves,epsilon,cycle,organs,round_trip_ms,solve_ms,overhead_ms,phase_computed,"
+           "iterations,warm_organs\n";
+    std::printf("%-26s %7s %8s %6s %7s %14s %10s %12s %6s %6s %7s\n", "what", "leaves", "epsilon",
+                "cycle", "organs", "round_trip_ms", "solve_ms", "overhead_ms", "phases", "sweeps",
+                "warm");
     for (const Row& r : rows) {
         csv << r.what << ',' << r.leaves << ',' << r.epsilon << ',' << r.cycle << ',' << r.organs
             << ',' << r.roundTripMs << ',' << r.solveMs << ',' << r.roundTripMs - r.solveMs << ','
-            << r.phaseComputed << '\n';
-        std::printf("%-14s %7d %8.0e %6d %7d %14.3f %10.3f %12.3f %6d\n", r.what.c_str(), r.leaves,
-                    r.epsilon, r.cycle, r.organs, r.roundTripMs, r.solveMs,
-                    r.roundTripMs - r.solveMs, r.phaseComputed);
+            << r.phaseComputed << ',' << r.iterations << ',' << r.warmOrgans << '\n';
+        std::printf("%-26s %7d %8.0e %6d %7d %14.3f %10.3f %12.3f %6d %6d %7lld\n", r.what.c_str(),
+                    r.leaves, r.epsilon, r.cycle, r.organs, r.roundTripMs, r.solveMs,
+                    r.roundTripMs - r.solveMs, r.phaseComputed, r.iterations,
+                    static_cast<long long>(r.warmOrgans));
     }
     std::printf("wrote %s\n", path);
     return 0;

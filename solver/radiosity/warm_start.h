@@ -1,0 +1,41 @@
+// Where a solve's iteration may start: the light its organs had at the end of an earlier
+// solve of much the same scene (a growth cycle's, the last one's). Jacobi from the emission
+// spends its first sweeps bringing the scattered light up from nothing; from the last
+// cycle's light, where little changed, the change still to come is small from the start.
+// The answer does not depend on it beyond the iteration's tolerance: the solve iterates to
+// the same fixed point from wherever it starts (HrcOptions::warmStart).
+#pragma once
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "solver/results/light.h"
+#include "solver/scene/geometry.h"
+
+namespace leaflux {
+
+class WarmStart {
+  public:
+    // The organs' irradiance on each side in every band of `solution`, solved on
+    // `receivers` (a flat scene's, or ReceiversOf's): by organ node, so that a scene whose
+    // organs were added, removed or moved since takes what is still there. Organs solved
+    // whole in a structure (Solution::unsolved) have no light of their own and are left out.
+    WarmStart(const std::vector<Receiver>& receivers, const Solution& solution);
+
+    int Bands() const { return bands_; }
+    std::size_t Organs() const { return row_.size(); }
+    // W/m² on the upper and lower side of organ `node` in band b: [2b], [2b + 1]; null when
+    // the earlier solve had no such organ.
+    const float* Of(NodeId node) const {
+        const auto it = row_.find(node);
+        return it == row_.end() ? nullptr : &irradiance_[it->second * 2 * bands_];
+    }
+
+  private:
+    int bands_ = 0;
+    std::unordered_map<NodeId, std::uint32_t> row_;
+    std::vector<float> irradiance_;
+};
+
+}  // namespace leaflux
