@@ -30,6 +30,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 REPORT = os.path.join(HERE, "report")
 RESULTS = os.path.join(ROOT, "docs", "results.md")
+DAEMON_RESULTS = os.path.join(ROOT, "docs", "results_daemon.md")  # the ray engine and daemon
 README = os.path.join(ROOT, "README.md")
 
 # name: (how to make the scene, what it is, bench error options)
@@ -662,20 +663,20 @@ def main():
         update(RESULTS, "demo", demo_section())
         update(RESULTS, "growth-instanced", instancing_section())
     if "daemon" in parts:
-        update(RESULTS, "daemon", daemon_section(build, os.path.join(out, "daemon"), run))
-        update(RESULTS, "daemon-protocol", daemon_protocol_section())
+        update(DAEMON_RESULTS, "daemon", daemon_section(build, os.path.join(out, "daemon"), run))
+        update(DAEMON_RESULTS, "daemon-protocol", daemon_protocol_section())
     if "daemon-accuracy" in parts:
-        update(RESULTS, "daemon-accuracy",
+        update(DAEMON_RESULTS, "daemon-accuracy",
                daemon_accuracy_section(build, os.path.join(out, "daemon_accuracy"), run))
     if "soak" in parts:
-        update(RESULTS, "soak", soak_section(build, os.path.join(out, "soak"), run))
+        update(DAEMON_RESULTS, "soak", soak_section(build, os.path.join(out, "soak"), run))
     if "render" in parts:
         table, pictures, culling = render_sections(build, os.path.join(out, "render"), run)
         update(RESULTS, "render", table)
         update(RESULTS, "render-culling", culling)
         update(README, "pictures", pictures)
     if "rays" in parts:
-        update(RESULTS, "rays", rays_section(build, os.path.join(out, "rays"), run))
+        update(DAEMON_RESULTS, "rays", rays_section(build, os.path.join(out, "rays"), run))
     if "phase-db" in parts:
         update(RESULTS, "phase-db", phase_db_section(build, os.path.join(out, "phase"), run))
     if "phase-spread" in parts:
@@ -687,7 +688,7 @@ def main():
         update(README, "accuracy", accuracy_section(build, os.path.join(out, "accuracy"), run))
     if "stability" in parts:
         update(RESULTS, "stability", stability_section(build, os.path.join(out, "stability"), run))
-    print(f"sections {args.only} rewritten in docs/results.md"
+    print(f"sections {args.only} rewritten in docs/results.md or docs/results_daemon.md"
           f"{' and the summary in README.md' if 'error' in parts or 'summary' in parts else ''}; files in {REPORT}")
 
 
