@@ -68,6 +68,24 @@ TEST(RayScene, ASelfShadowQuerySeesOnlyItsGroup) {
     EXPECT_TRUE(rays.OccludedByGroup(onMiddle, {0, 0, 1}, 10.0, top));
 }
 
+// The first triangles count but the ranges skipped (a closed instance's own organs, which
+// its light already passed): three plates stacked at z = 0, 1 and 2, two triangles each.
+TEST(RayScene, AnOcclusionQueryPassesTheTrianglesItSkips) {
+    const FlatScene flat = Plates({Rectangle(1, 1, 0), Rectangle(1, 1, 1), Rectangle(1, 1, 2)});
+    const RayScene rays(flat, std::nullopt);
+    const RayStart below{flat.ToLocal({0.1, 0.2, -1})};
+    const glm::dvec3 up{0, 0, 1};
+    const RayScene::TriangleRanges first{{0, 2}}, lower{{0, 4}}, apart{{0, 2}, {4, 6}}, all{{0, 6}};
+    EXPECT_TRUE(rays.OccludedByFirst(below, up, 10.0, 6, &first));   // the second plate
+    EXPECT_TRUE(rays.OccludedByFirst(below, up, 10.0, 6, &lower));   // the third
+    EXPECT_FALSE(rays.OccludedByFirst(below, up, 10.0, 4, &lower));  // beyond the first 4
+    EXPECT_TRUE(rays.OccludedByFirst(below, up, 10.0, 6, &apart));   // the middle one
+    EXPECT_FALSE(rays.OccludedByFirst(below, up, 10.0, 6, &all));
+    EXPECT_FALSE(rays.OccludedByFirst(below, up, 1.5, 6, &first));  // ends short of the second
+    for (std::uint32_t t = 0; t < 8; ++t)
+        EXPECT_EQ(RayScene::InRanges(apart, t), t < 2 || (t >= 4 && t < 6)) << t;
+}
+
 TEST(RayScene, TracesRaysOfOneDirectionTogetherAsOneByOne) {
     // Plates 1 µm to 0.3 m apart, shifted sideways: rays leave every triangle (and points
     // off the surfaces) towards one sun, some blocked, some not.

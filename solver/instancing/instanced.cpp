@@ -160,6 +160,9 @@ class InstancedSolve {
     bool HoldsNodeOf(std::uint32_t q, NodeType type) const;
     // Closed instance c of `level` solved whole from the light that arrived on it.
     void SolveWhole(const Level& level, const LevelSolution& light, std::size_t c);
+    // Where the organs of part q and of the parts in it lie in the shadow engine
+    // (ClosedNode::shadowTriangles).
+    void ShadowTriangles(std::uint32_t q, ClosedNode& closed) const;
     // Marks the organs of part q and of the parts in it unsolved; their count and area.
     void MarkUnsolved(std::uint32_t q, StructureLight& whole);
     void Open(const Level& parent, std::size_t c, std::vector<DirectionalSource> sources,
@@ -239,6 +242,7 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
         closed.boxMin = instance.boxMin;
         closed.boxMax = instance.boxMax;
         closed.areaM2 = instance.leafAreaM2;
+        ShadowTriangles(q, closed);
         const std::shared_ptr<const Original>& original =
             originals_.bySignature.at(instance.signature);
         closed.contents = std::make_shared<OriginalContents>(
@@ -490,6 +494,34 @@ bool InstancedSolve::Opens(std::uint32_t q, const glm::dmat4& worldFromRoot) con
     const NodeType type = *options_.outputLevel;
     return HoldsInstanceOf(q, type) ||
            (scene_.nodes[tree_[q].rootIndex].type != type && HoldsNodeOf(q, type));
+}
+
+void InstancedSolve::ShadowTriangles(std::uint32_t q, ClosedNode& closed) const {
+    RayScene::TriangleRanges ranges;
+    std::vector<std::uint32_t> parts = {q};
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+        for (std::size_t i : tree_[parts[k]].nodes) {
+            const auto it = organReceiver_.find(scene_.nodes[i].id);
+            if (it == organReceiver_.end()) continue;
+            const Receiver& r = receivers_.receivers[it->second];
+            if (r.triangleCount > 0)
+                ranges.push_back({r.firstTriangle, r.firstTriangle + r.triangleCount});
+        }
+        const auto& inner = tree_[parts[k]].instances;
+        parts.insert(parts.end(), inner.begin(), inner.end());
+    }
+    std::sort(ranges.begin(), ranges.end());
+    RayScene::TriangleRanges merged;
+    for (const auto& range : ranges) {
+        if (!merged.empty() && range[0] <= merged.back()[1]) {
+            merged.back()[1] = std::max(merged.back()[1], range[1]);
+        } else {
+            merged.push_back(range);
+        }
+    }
+    if (!merged.empty())
+        closed.shadowTriangles =
+            std::make_shared<const RayScene::TriangleRanges>(std::move(merged));
 }
 
 void InstancedSolve::MarkUnsolved(std::uint32_t q, StructureLight& whole) {

@@ -219,7 +219,7 @@ Refiner::Verdict Refiner::JudgePair(std::uint32_t r, std::uint32_t s) const {
         verdict.links = HeldAroundLinks(
             model_, r, s,
             [&](const Hierarchy::Point& p, const glm::dvec3& direction, double length) {
-                return visibility_.HeldTransmittance(p, direction, length);
+                return visibility_.HeldTransmittance(p, direction, length, held);
             },
             verdict.rays);
         if (!verdict.links.empty()) verdict.kind = Verdict::kLink;

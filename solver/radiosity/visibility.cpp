@@ -67,7 +67,7 @@ double LinkVisibility::HeldEntry(std::int32_t closed, const glm::dvec3& from,
 }
 
 double LinkVisibility::HeldTransmittance(const Hierarchy::Point& p, const glm::dvec3& direction,
-                                         double length) const {
+                                         double length, const ClosedNode* inside) const {
     const std::int32_t ends[2] = {p.closed, -1};
     const ShadowView& shadows = occlusion_.Shadows();
     if (!shadows.rays) {
@@ -85,7 +85,8 @@ double LinkVisibility::HeldTransmittance(const Hierarchy::Point& p, const glm::d
         start.triangle = shadows.triangleOf[p.triangle];
     }
     if (from >= length) return 1.0;
-    return shadows.rays->OccludedByFirst(start, direction, length - from, shadows.organTriangles)
+    return shadows.rays->OccludedByFirst(start, direction, length - from, shadows.organTriangles,
+                                         inside ? inside->shadowTriangles.get() : nullptr)
                ? 0.0
                : 1.0;
 }

@@ -42,9 +42,11 @@ struct Sight {
 
 class LinkVisibility {
   public:
-    // Along a ray from p towards a held surface, `length` long.
-    double HeldTransmittance(const Hierarchy::Point& p, const glm::dvec3& direction,
-                             double length) const;
+    // Along a ray from p towards a held surface, `length` long; `inside`: a held closed
+    // instance the ray ends in, whose own organs it passes (what they take of its light is
+    // in the intensity it sends).
+    double HeldTransmittance(const Hierarchy::Point& p, const glm::dvec3& direction, double length,
+                             const ClosedNode* inside = nullptr) const;
     LinkVisibility(const NodeModel& model, const Field& field, const Occlusion& occlusion,
                    int visibilityRays, int sourceRays)
         : hierarchy_(model.Nodes()),

@@ -35,6 +35,7 @@ struct StartContext {
     int copy;
     const RayScene::Group* group = nullptr;
     std::uint32_t limit = kNoTriangle;
+    const RayScene::TriangleRanges* skip = nullptr;  // triangles that do not count
 };
 
 void IgnoreStartTriangle(const RTCFilterFunctionNArguments* args) {
@@ -42,11 +43,13 @@ void IgnoreStartTriangle(const RTCFilterFunctionNArguments* args) {
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
         const unsigned triangle = RTCRayN_id(args->ray, args->N, i);
-        if (triangle == kNoTriangle && !start->group && start->limit == kNoTriangle) continue;
+        if (triangle == kNoTriangle && !start->group && start->limit == kNoTriangle && !start->skip)
+            continue;
         const unsigned instance = RTCHitN_instID(args->hit, args->N, i, 0);
         const int copy = instance == RTC_INVALID_GEOMETRY_ID ? 0 : static_cast<int>(instance);
         const unsigned primitive = RTCHitN_primID(args->hit, args->N, i);
         if (primitive >= start->limit) args->valid[i] = 0;
+        if (start->skip && RayScene::InRanges(*start->skip, primitive)) args->valid[i] = 0;
         if (primitive == triangle && copy == start->copy) args->valid[i] = 0;
         if (const RayScene::Group* group = start->group) {
             const std::uint32_t rank = group->rank[primitive];
@@ -298,10 +301,12 @@ void RayScene::Occluded(const std::vector<RayStart>& starts,
 }
 
 bool RayScene::OccludedByFirst(const RayStart& start, const glm::dvec3& direction,
-                               double maxDistance, std::uint32_t triangles) const {
+                               double maxDistance, std::uint32_t triangles,
+                               const TriangleRanges* skip) const {
     LEAFLUX_CHECK(!periodic_);
     StartContext context = MakeContext(0);
     context.limit = triangles;
+    context.skip = skip != nullptr && !skip->empty() ? skip : nullptr;
     RTCRay ray = EmbreeRay(start, direction, maxDistance);
     rtcOccluded1(top_, &context.context, &ray);
     return ray.tfar < 0.0f;

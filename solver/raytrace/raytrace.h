@@ -8,6 +8,8 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <glm/glm.hpp>
@@ -95,10 +97,19 @@ class RayScene {
     // The same with a direction per ray (the rays of a cone of light).
     void Occluded(const std::vector<RayStart>& starts, const std::vector<glm::dvec3>& directions,
                   std::vector<std::uint8_t>& occluded) const;
+    // Triangles as sorted, disjoint ranges [from, to) of their indices.
+    using TriangleRanges = std::vector<std::array<std::uint32_t, 2>>;
+    static bool InRanges(const TriangleRanges& ranges, std::uint32_t triangle) {
+        const auto after = std::upper_bound(
+            ranges.begin(), ranges.end(), triangle,
+            [](std::uint32_t t, const std::array<std::uint32_t, 2>& r) { return t < r[0]; });
+        return after != ranges.begin() && triangle < (after - 1)->at(1);
+    }
     // Whether one of the scene's first `triangles` triangles (a flat scene's organs, which
-    // it lists first) lies along the ray within maxDistance. Not periodic.
+    // it lists first), but those of `skip`, lies along the ray within maxDistance. Not
+    // periodic.
     bool OccludedByFirst(const RayStart& start, const glm::dvec3& direction, double maxDistance,
-                         std::uint32_t triangles) const;
+                         std::uint32_t triangles, const TriangleRanges* skip = nullptr) const;
 
     // A group of triangles: those whose rank (an index by triangle) lies in [first, last).
     struct Group {
