@@ -219,8 +219,8 @@ class SceneSolve {
         pushPull_.PullUp(field_);
     }
     // The leaf patches of the organs HrcOptions::warmStart has: on the first arrival they
-    // hold, the light their organ had there beyond its first arrival (the light scattered
-    // onto it, its mean). Returns how many organs it had.
+    // hold, the light scattered onto their organ there (WarmStart::Apply). Returns how
+    // many organs it had.
     std::int64_t WarmLeaves();
     // Jacobi from the emission, then refine–solve passes until no link needs refining.
     void Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock);
@@ -434,45 +434,7 @@ std::int64_t SceneSolve::WarmLeaves() {
     if (warm == nullptr || options_.directOnly || channels_.beams != 1 ||
         warm->Bands() != channels_.bands)
         return 0;
-    // What the first arrival (the sources', lamps' and held senders' light, just gathered)
-    // brings each organ on average: the earlier light less it is what was scattered onto the
-    // organ. The first arrival stays each patch's own (sun and shade on a leaf); the
-    // scattered light is spread evenly, so that the first sweeps still even it out where a
-    // neighbour leaf lies close (the 10,000-leaf tree, warm from its own solution: the first
-    // change 13 % of the largest radiosity, against 26 % from the direct light).
-    const int sides = 2 * channels_.bands;
-    std::vector<double> first(flat_.receivers.size() * sides, 0.0), area(flat_.receivers.size());
-    const std::vector<std::uint32_t>& leaves = traversal_.Leaves();
-    for (std::uint32_t n : leaves) {
-        const std::uint32_t r = hierarchy_[n].receiver;
-        if (flat_.receivers[r].kind != ReceiverKind::kOrgan) continue;
-        const double a = hierarchy_[n].areaM2;
-        area[r] += a;
-        for (int b = 0; b < channels_.bands; ++b) {
-            first[r * sides + 2 * b] += a * leafLight_.irradiance(n, kUpper)[b];
-            first[r * sides + 2 * b + 1] += a * leafLight_.irradiance(n, kLower)[b];
-        }
-    }
-    std::int64_t found = 0;
-    for (std::uint32_t r = 0; r < flat_.receivers.size(); ++r) {
-        const float* light = area[r] > 0.0 ? warm->Of(flat_.receivers[r].node) : nullptr;
-        if (light == nullptr) {
-            area[r] = 0.0;
-            continue;
-        }
-        ++found;
-        for (int k = 0; k < sides; ++k)
-            first[r * sides + k] = std::max(0.0, light[k] - first[r * sides + k] / area[r]);
-    }
-    for (std::uint32_t n : leaves) {
-        const std::uint32_t r = hierarchy_[n].receiver;
-        if (area[r] <= 0.0) continue;
-        for (int b = 0; b < channels_.bands; ++b) {
-            leafLight_.irradiance(n, kUpper)[b] += first[r * sides + 2 * b];
-            leafLight_.irradiance(n, kLower)[b] += first[r * sides + 2 * b + 1];
-        }
-    }
-    return found;
+    return warm->Apply(hierarchy_, flat_.receivers, traversal_.Leaves(), leafLight_.irradiance);
 }
 
 void SceneSolve::Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock) {

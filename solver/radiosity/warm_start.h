@@ -10,6 +10,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "solver/radiosity/channels.h"
+#include "solver/radiosity/hierarchy.h"
 #include "solver/results/light.h"
 #include "solver/scene/geometry.h"
 
@@ -31,6 +33,16 @@ class WarmStart {
         const auto it = row_.find(node);
         return it == row_.end() ? nullptr : &irradiance_[it->second * 2 * bands_];
     }
+
+    // On the first arrival `irradiance` holds on the leaf patches `leaves` (one channel per
+    // band, by `receivers`), the light scattered onto each organ it has: the organ's light
+    // less its patches' mean first arrival, alike on its patches. The first arrival stays
+    // each patch's own (sun and shade on a leaf); the scattered light is spread evenly, and
+    // the first sweeps still even it out where a neighbour leaf lies close (the
+    // 10,000-leaf tree, warm from its own solution: the first change 13 % of the largest
+    // radiosity, against 26 % from the direct light). Returns the organs it had.
+    std::int64_t Apply(const Hierarchy& hierarchy, const std::vector<Receiver>& receivers,
+                       const std::vector<std::uint32_t>& leaves, SideTable& irradiance) const;
 
   private:
     int bands_ = 0;
