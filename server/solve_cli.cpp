@@ -143,6 +143,9 @@ std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
     settings.hrc.threads = command.threads;
     settings.monteCarlo.directOnly = settings.hrc.directOnly = command.directOnly;
     if (!command.warmStart.empty()) {
+        if (command.solver == "mc")
+            throw InputError(ErrorCode::kInvalidArgument, "--warm-start",
+                             "is for the hrc and instanced solvers; mc starts nothing");
         settings.hrc.warmStart = std::make_shared<const WarmStart>(
             flat.receivers, ReadLeafCsv(command.warmStart, scene, flat));
     }

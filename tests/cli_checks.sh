@@ -6,7 +6,7 @@
 # ignores; leaflux-grow's --ply-cycles and stand options; solve's CSV in W and µmol; client
 # cycle --out writes the Python package's CSV, in W and µmol (empty for a band without a
 # photon unit), and prints a summary; the example scripts run as they are and answer --help;
-# solve --ply writes the scene's triangles with every solver.
+# solve --ply writes the scene's triangles with every solver; solve --warm-start.
 # Usage: cli_checks.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
 leaflux=$1/server/leaflux
@@ -105,6 +105,15 @@ for shadows in geometry transmittance; do
     [ "$(faces "$out/i.ply")" = "$(faces "$out/h.ply")" ] && [ "$(faces "$out/h.ply")" -gt 0 ] ||
         fail "instanced --ply ($shadows): $(faces "$out/i.ply") faces, hrc $(faces "$out/h.ply")"
 done
+
+# --warm-start: an earlier --out starts the iteration (every organ found); Monte Carlo, which
+# has no iteration, refuses it naming the option.
+"$leaflux" solve --scene "$out/t40.scene.txtpb" --quiet --solver hrc --out "$out/w.csv" \
+    --warm-start "$out/h.csv" > "$out/warm.log"
+grep -q "organs warm-started" "$out/warm.log" || fail "--warm-start: no organ started warm"
+refused "$leaflux" solve --scene "$out/t40.scene.txtpb" --quiet --solver mc --out "$out/m.csv" \
+    --warm-start "$out/h.csv"
+grep -q -- "--warm-start" "$out/last.log" || fail "--warm-start with mc: not named"
 
 # leaflux-grow: a sentence for a bad cycle list; a stand's options on a scenario without one.
 refused "$grow" --scenario "$source/growth_stub/scenarios/stand.txtpb" --ply-cycles 2,x \

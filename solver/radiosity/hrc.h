@@ -106,9 +106,9 @@ struct HrcOptions {
     // direction of the cluster light's set; false: the same power alike in every direction,
     // the single value of Soler 2003 (§6 names it the main error at small ε).
     bool directionalInstances = true;
-    // Where set, the leaves of the organs it has start the iteration from the light they
-    // had there instead of from the direct light alone (warm_start.h): the same answer
-    // within `tolerance`, in fewer sweeps where the light changed little.
+    // Where set, the leaves of the organs it has start from the light they had there
+    // instead of from the direct light alone (warm_start.h): a cold start's answer within a
+    // small part of what ε costs, in fewer sweeps where the light changed little.
     std::shared_ptr<const WarmStart> warmStart;
 };
 

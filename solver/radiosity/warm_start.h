@@ -2,8 +2,10 @@
 // solve of much the same scene (a growth cycle's, the last one's). Jacobi from the emission
 // spends its first sweeps bringing the scattered light up from nothing; from the last
 // cycle's light, where little changed, the change still to come is small from the start.
-// The answer does not depend on it beyond the iteration's tolerance: the solve iterates to
-// the same fixed point from wherever it starts (HrcOptions::warmStart).
+// The iteration alone reaches the same fixed point from wherever it starts; the links,
+// judged in the light it has reached, may be chosen otherwise, each within ε, so the
+// answer is a cold start's within a small part of what ε costs (HrcOptions::warmStart,
+// tests/warm_start_test.cpp).
 #pragma once
 
 #include <cstdint>
@@ -26,7 +28,6 @@ class WarmStart {
     WarmStart(const std::vector<Receiver>& receivers, const Solution& solution);
 
     int Bands() const { return bands_; }
-    std::size_t Organs() const { return row_.size(); }
     // W/m² on the upper and lower side of organ `node` in band b: [2b], [2b + 1]; null when
     // the earlier solve had no such organ.
     const float* Of(NodeId node) const {
