@@ -56,25 +56,34 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
         if (owner[i] != kTop && parts_[owner[i]].root == node.id)
             parts_[part.parent].instances.push_back(owner[i]);
     }
-    // Boxes and areas over each instance's whole subtree, in its own frame.
+    // Boxes, areas and where the areas lie over each instance's whole subtree, in its own
+    // frame.
     const auto worldFromLocal = WorldFromLocal(scene);
     for (std::uint32_t p = 1; p < parts_.size(); ++p) {
         Part& part = parts_[p];
         const glm::dmat4 worldFromInstance = worldFromLocal.at(part.root);
         glm::dvec3 lo(std::numeric_limits<double>::max()), hi = -lo;
+        std::vector<std::pair<glm::dvec3, double>> triangles;  // centroid and area
         std::vector<std::pair<std::size_t, glm::dmat4>> walk{{part.rootIndex, glm::dmat4(1.0)}};
         while (!walk.empty()) {
             const auto [i, instanceFromNode] = walk.back();
             walk.pop_back();
             const Node& node = scene.nodes[i];
             if (node.organ) {
-                for (const glm::dvec3& v : node.organ->mesh->positions) {
-                    const glm::dvec3 q(instanceFromNode * glm::dvec4(v, 1.0));
-                    lo = glm::min(lo, q);
-                    hi = glm::max(hi, q);
+                const Mesh& mesh = *node.organ->mesh;
+                std::vector<glm::dvec3> q;
+                q.reserve(mesh.positions.size());
+                for (const glm::dvec3& v : mesh.positions) {
+                    q.emplace_back(instanceFromNode * glm::dvec4(v, 1.0));
+                    lo = glm::min(lo, q.back());
+                    hi = glm::max(hi, q.back());
                 }
-                part.leafAreaM2 +=
-                    MeshArea(*node.organ->mesh, worldFromInstance * instanceFromNode);
+                const glm::dmat4 worldFromNode = worldFromInstance * instanceFromNode;
+                for (const glm::uvec3& t : mesh.triangles) {
+                    const double area = TriangleArea(worldFromNode, mesh, t);
+                    triangles.push_back({(q[t.x] + q[t.y] + q[t.z]) / 3.0, area});
+                    part.leafAreaM2 += area;
+                }
             }
             for (std::size_t c : children[i])
                 walk.push_back({c, instanceFromNode * scene.nodes[c].parentFromLocal});
@@ -83,6 +92,14 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
         const double pad = std::max(kMinPadM, kPadFraction * glm::length(hi - lo));
         part.boxMin = lo - pad;
         part.boxMax = hi + pad;
+        if (part.leafAreaM2 > 0.0) {
+            auto grid = std::make_shared<AreaGrid>();
+            for (const auto& [centroid, area] : triangles) {
+                grid->share[AreaGrid::CellOf(centroid, part.boxMin, part.boxMax)] +=
+                    static_cast<float>(area / part.leafAreaM2);
+            }
+            part.area = std::move(grid);
+        }
     }
 }
 

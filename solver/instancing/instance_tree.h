@@ -10,10 +10,12 @@
 
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "solver/instancing/signature.h"
+#include "solver/radiosity/closed_node.h"
 #include "solver/scene/scene.h"
 
 namespace leaflux {
@@ -34,6 +36,7 @@ class InstanceTree {
         // (one side, as an original's), over its whole subtree.
         glm::dvec3 boxMin{0.0}, boxMax{0.0};
         double leafAreaM2 = 0.0;
+        std::shared_ptr<const AreaGrid> area;  // where in the box that area lies
         std::int64_t triangles = 0;  // of its own nodes' organs
     };
 

@@ -242,6 +242,7 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
         closed.boxMin = instance.boxMin;
         closed.boxMax = instance.boxMax;
         closed.areaM2 = instance.leafAreaM2;
+        closed.organArea = instance.area;
         ShadowTriangles(q, closed);
         const std::shared_ptr<const Original>& original =
             originals_.bySignature.at(instance.signature);

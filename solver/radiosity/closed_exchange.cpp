@@ -9,7 +9,8 @@
 namespace leaflux {
 namespace {
 
-// Points of a box spread evenly through it: the centres of a 4 × 4 × 4 grid of its cells.
+// Points of a box spread evenly through it: the centres of a 4 × 4 × 4 grid of its cells;
+// a receiver's in HeldAroundLinks, the centres of a 4 × 4 grid over it.
 constexpr int kCells = 4;
 
 // The share of the line x + t ω, t ≥ 0, of the box [lo, hi] (instance frame) over its whole
@@ -19,6 +20,35 @@ double ChordShare(const glm::dvec3& x, const glm::dvec3& omega, const glm::dvec3
     const BoxSpan span = LineThroughBox(x, omega, lo, hi);
     if (!span.Meets() || span.exit <= 0.0) return 0.0;
     return (span.exit - std::max(span.enter, 0.0)) / (span.exit - span.enter);
+}
+
+// Where the light a closed instance sends along a line leaves from, between distances
+// `from` and `to` along it: ∫ e dℓ, e the share of its light leaving per m³ (its organs'
+// area share per cell over the cell's volume; 1 / V without an AreaGrid), and the distance
+// that integral is centred on.
+struct Emitters {
+    double integral = 0.0;  // 1/m²
+    double distance = 0.0;  // m
+};
+Emitters EmittersAlong(const ClosedNode& sender, const glm::dvec3& x, const glm::dvec3& along,
+                       double from, double to, double volume) {
+    const double length = to - from;
+    if (!sender.organArea) return {length / volume, from + 0.5 * length};
+    // Midpoints of steps a quarter of a cell's side at most where the line is longest.
+    constexpr int kSteps = 4 * AreaGrid::kCells;
+    constexpr double kCellVolumes = AreaGrid::kCount;
+    const double step = length / kSteps;
+    Emitters e;
+    for (int k = 0; k < kSteps; ++k) {
+        const double t = from + (k + 0.5) * step;
+        const int cell = AreaGrid::CellOf(x + t * along, sender.boxMin, sender.boxMax);
+        const double density =
+            static_cast<double>(sender.organArea->share[cell]) * kCellVolumes / volume;
+        e.integral += density * step;
+        e.distance += density * step * t;
+    }
+    if (e.integral > 0.0) e.distance /= e.integral;
+    return e;
 }
 
 }  // namespace
@@ -108,17 +138,20 @@ std::vector<NodeLink> HeldAroundLinks(
     for (int d = 0; d < directions.Size(); ++d) {
         const glm::dvec3& omega = directions.Direction(d);  // the way the light goes
         const glm::dvec3 back = linear * -omega;            // towards where it comes from
-        double behind = 0.0;  // the mean ℓ (m), as far as seen from the point
+        double behind = 0.0;  // the mean ∫ e dℓ (1/m²), as far as seen from the point
         // A point of each row of r's grid, in a column that turns with the bin: each bin
         // sees r's whole extent, and the bins together every point.
         for (int row = 0; row < kCells; ++row) {
             const std::size_t i = row * kCells + (row + d) % kCells;
             const BoxSpan span = LineThroughBox(points[i], back, sender.boxMin, sender.boxMax);
             if (!span.Meets() || span.exit <= 0.0) continue;
-            const double from = std::max(span.enter, 0.0), length = span.exit - from;
-            // Seen as far as the middle of that part.
+            const double from = std::max(span.enter, 0.0);
+            const Emitters behindPoint = EmittersAlong(sender, points[i], back, from, span.exit,
+                                                       volume);
+            if (behindPoint.integral <= 0.0) continue;
+            // Seen as far as where the light it meets leaves from, on the whole.
             ++rays;
-            behind += length * passed(at[i], -omega, from + 0.5 * length);
+            behind += behindPoint.integral * passed(at[i], -omega, behindPoint.distance);
         }
         behind /= static_cast<double>(kCells);
         if (behind <= 0.0) continue;
@@ -126,7 +159,7 @@ std::vector<NodeLink> HeldAroundLinks(
         link.sender = s;
         link.ownRays = true;  // its rays traced here
         link.toSender = glm::vec3(-omega);
-        link.transfer[0] = static_cast<float>(directions.HatIntegralSr(d) * behind / volume);
+        link.transfer[0] = static_cast<float>(directions.HatIntegralSr(d) * behind);
         link.receiverBins = Locate(directions, -omega);
         link.senderBins.index = {static_cast<std::uint16_t>(d), static_cast<std::uint16_t>(d),
                                  static_cast<std::uint16_t>(d)};

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "solver/raytrace/occlusion.h"
+#include "solver/util/area_grid.h"
 #include "solver/scene/scene.h"
 
 namespace leaflux {
@@ -56,6 +57,8 @@ struct ClosedNode {
     // Its organs' triangles in the whole scene's shadow engine (ShadowView), when it has
     // one: what its intensity already lost to them is not lost again (HeldAroundLinks).
     std::shared_ptr<const RayScene::TriangleRanges> shadowTriangles;
+    // Where its organs lie in its box, when known; else its light leaves evenly from the box.
+    std::shared_ptr<const AreaGrid> organArea;
 
     bool Held() const { return !held.empty(); }
 

@@ -375,14 +375,16 @@ std::unordered_map<NodeId, glm::dmat4> WorldFromLocal(const Scene& scene) {
     return result;
 }
 
+double TriangleArea(const glm::dmat4& worldFromLocal, const Mesh& mesh, const glm::uvec3& tri) {
+    const glm::dvec3 a = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.x], 1.0));
+    const glm::dvec3 b = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.y], 1.0));
+    const glm::dvec3 c = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.z], 1.0));
+    return 0.5 * glm::length(glm::cross(b - a, c - a));
+}
+
 double MeshArea(const Mesh& mesh, const glm::dmat4& worldFromLocal) {
     double area = 0.0;
-    for (const glm::uvec3& tri : mesh.triangles) {
-        const glm::dvec3 a = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.x], 1.0));
-        const glm::dvec3 b = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.y], 1.0));
-        const glm::dvec3 c = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.z], 1.0));
-        area += 0.5 * glm::length(glm::cross(b - a, c - a));
-    }
+    for (const glm::uvec3& tri : mesh.triangles) area += TriangleArea(worldFromLocal, mesh, tri);
     return area;
 }
 

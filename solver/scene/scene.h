@@ -140,5 +140,7 @@ std::unordered_map<NodeId, glm::dmat4> WorldFromLocal(const Scene& scene);
 
 // Area (m²) of a triangle mesh after applying worldFromLocal.
 double MeshArea(const Mesh& mesh, const glm::dmat4& worldFromLocal);
+// The area of one of the mesh's triangles, in the frame worldFromLocal takes it to.
+double TriangleArea(const glm::dmat4& worldFromLocal, const Mesh& mesh, const glm::uvec3& tri);
 
 }  // namespace leaflux
