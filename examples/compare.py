@@ -2,7 +2,9 @@
 """Compares per-leaf results of two solvers: `compare.py REFERENCE.csv OTHER.csv`.
 Prints, per band, the L2 error in % of the reference maximum (Soler 2003, Fig. 14), the
 mean and 95th-percentile relative errors over lit leaves (5 % of the brightest or more),
-and the mean signed error of each fifth of the leaves from the darkest to the brightest
+what all the leaves' upper and lower sides take together against the reference's (a
+solver that sends scattered light the wrong way shows on one side), and the mean signed
+error of each fifth of the leaves from the darkest to the brightest
 (in % of the maximum): a solver that spreads light too evenly is high in the first fifths
 and low in the last. With `--scene SCENE --by TYPE`, the L2 error split into the part the
 leaves of one structure share (each structure's mean error: the smallest structure of TYPE
@@ -27,6 +29,24 @@ def load(path):
             values[(row["organ"], row["band"])] = (float(row["irradiance_upper_wm2"]) +
                                                    float(row["irradiance_lower_wm2"]))
     return values
+
+
+def load_sides(path):
+    """Leaf area (m²) and the power on its upper and lower sides (W) by (organ, band)."""
+    values = {}
+    for row in csv.DictReader(open(path)):
+        if row["organ"].startswith("leaf"):
+            area = float(row["area_m2"])
+            values[(row["organ"], row["band"])] = (area * float(row["irradiance_upper_wm2"]),
+                                                   area * float(row["irradiance_lower_wm2"]))
+    return values
+
+
+def sides_against(reference, value, band):
+    """(upper, lower): what all the leaves' sides take, in % off the reference's."""
+    keys = [k for k in reference if k[1] == band]
+    return tuple(100 * (sum(value[k][s] for k in keys) / sum(reference[k][s] for k in keys) - 1)
+                 for s in (0, 1))
 
 
 def errors(reference, value, band):
@@ -103,10 +123,14 @@ def main():
                              "the default policy's smallest instance)")
     args = parser.parse_args()
     reference, value = load(args.reference), load(args.other)
+    reference_sides, value_sides = load_sides(args.reference), load_sides(args.other)
     holder = structure_of_leaves(args.scene, args.by, args.min_leaves) if args.scene else None
     for band in sorted({k[1] for k in reference}):
         l2, mean, p95 = errors(reference, value, band)
         print(f"{band}: L2 {l2:.2f} % of max, mean relative {mean:.2f} %, 95th percentile {p95:.2f} %")
+        upper, lower = sides_against(reference_sides, value_sides, band)
+        print(f"{band}: all upper sides {upper:+.2f} %, all lower sides {lower:+.2f} % "
+              f"against the reference")
         fifths = " ".join(f"{b:+.2f}" for b in bias_by_fifth(reference, value, band))
         print(f"{band}: mean signed error by fifth, darkest to brightest (% of max): {fifths}")
         if holder is not None:

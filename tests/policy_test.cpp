@@ -104,7 +104,7 @@ TEST(PolicyFile, ShippedPoliciesParseAndValidate) {
         EXPECT_TRUE(policy.IsInstanceType(NodeType::kPlant));
         EXPECT_TRUE(policy.IsInstanceType(NodeType::kAxis));
         EXPECT_TRUE(policy.leafCount.Used());
-        EXPECT_EQ(policy.phase.kind, PhaseKind::kMonoDirectional);
+        EXPECT_EQ(policy.phase.kind, PhaseKind::kBiDirectional);
         EXPECT_EQ(policy.phase.level, 3);  // 130 directions
         EXPECT_EQ(policy.transmittance.level, 3);
     }
@@ -365,7 +365,7 @@ leaf_count {
 fixed { type: NODE_TYPE_AXIS leaf_count_above: 10000 }
 fixed { type: NODE_TYPE_PLANT leaf_count_above: 10000 }
 transmittance { direction_count: 130 kind: FUNCTION_KIND_MONO }
-phase { level: 3 kind: FUNCTION_KIND_MONO }
+phase { level: 3 kind: FUNCTION_KIND_BI }
 )");
     EXPECT_EQ(PolicyContentHash(LoadPolicyFile(path)), PolicyContentHash(shipped));
     const std::string changed = Write("changed_policy.txtpb", R"(
@@ -373,7 +373,7 @@ species: "default" instance_types: [NODE_TYPE_PLANT, NODE_TYPE_AXIS] by_type: tr
 leaf_count { edges: [11, 100, 1000, 10000] }
 fixed { type: NODE_TYPE_PLANT leaf_count_above: 10000 }
 fixed { type: NODE_TYPE_AXIS leaf_count_above: 10001 }
-phase { kind: FUNCTION_KIND_MONO direction_count: 130 }
+phase { kind: FUNCTION_KIND_BI direction_count: 130 }
 transmittance { kind: FUNCTION_KIND_MONO direction_count: 130 }
 )");
     EXPECT_NE(PolicyContentHash(LoadPolicyFile(changed)), PolicyContentHash(shipped));
