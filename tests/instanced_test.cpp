@@ -385,15 +385,14 @@ TEST(Instanced, AnInstancesAreaGridHoldsItsOrgansWhereTheyLie) {
     EXPECT_NEAR(total, 1.0, 1e-5);
     // The organs' area centroid, in the plant's frame (its root's), from the flat scene.
     const PreparedScene prepared(scene);
-    const glm::dmat4 instanceFromScene =
-        glm::inverse(WorldFromLocal(scene).at(plant.root)) *
-        glm::translate(glm::dmat4(1.0), prepared.Flat().origin);
+    const glm::dmat4 instanceFromScene = glm::inverse(WorldFromLocal(scene).at(plant.root)) *
+                                         glm::translate(glm::dmat4(1.0), prepared.Flat().origin);
     glm::dvec3 centroid(0.0);
     double area = 0.0;
     for (const Triangle& t : prepared.Flat().triangles) {
         if (prepared.Flat().receivers[t.receiver].kind != ReceiverKind::kOrgan) continue;
-        centroid += t.areaM2 * glm::dvec3(instanceFromScene *
-                                          glm::dvec4((t.a + t.b + t.c) / 3.0, 1.0));
+        centroid +=
+            t.areaM2 * glm::dvec3(instanceFromScene * glm::dvec4((t.a + t.b + t.c) / 3.0, 1.0));
         area += t.areaM2;
     }
     centroid /= area;

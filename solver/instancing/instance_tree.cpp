@@ -57,49 +57,50 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
             parts_[part.parent].instances.push_back(owner[i]);
     }
     // Boxes, areas and where the areas lie over each instance's whole subtree, in its own
-    // frame.
+    // frame: the box first, then the area cell by cell (two walks, so that nothing the
+    // size of the subtree is kept).
     const auto worldFromLocal = WorldFromLocal(scene);
-    for (std::uint32_t p = 1; p < parts_.size(); ++p) {
-        Part& part = parts_[p];
-        const glm::dmat4 worldFromInstance = worldFromLocal.at(part.root);
-        glm::dvec3 lo(std::numeric_limits<double>::max()), hi = -lo;
-        std::vector<std::pair<glm::dvec3, double>> triangles;  // centroid and area
+    const auto walkOrgans = [&](const Part& part, const auto& visit) {
         std::vector<std::pair<std::size_t, glm::dmat4>> walk{{part.rootIndex, glm::dmat4(1.0)}};
         while (!walk.empty()) {
             const auto [i, instanceFromNode] = walk.back();
             walk.pop_back();
-            const Node& node = scene.nodes[i];
-            if (node.organ) {
-                const Mesh& mesh = *node.organ->mesh;
-                std::vector<glm::dvec3> q;
-                q.reserve(mesh.positions.size());
-                for (const glm::dvec3& v : mesh.positions) {
-                    q.emplace_back(instanceFromNode * glm::dvec4(v, 1.0));
-                    lo = glm::min(lo, q.back());
-                    hi = glm::max(hi, q.back());
-                }
-                const glm::dmat4 worldFromNode = worldFromInstance * instanceFromNode;
-                for (const glm::uvec3& t : mesh.triangles) {
-                    const double area = TriangleArea(worldFromNode, mesh, t);
-                    triangles.push_back({(q[t.x] + q[t.y] + q[t.z]) / 3.0, area});
-                    part.leafAreaM2 += area;
-                }
-            }
+            if (scene.nodes[i].organ) visit(*scene.nodes[i].organ->mesh, instanceFromNode);
             for (std::size_t c : children[i])
                 walk.push_back({c, instanceFromNode * scene.nodes[c].parentFromLocal});
         }
+    };
+    for (std::uint32_t p = 1; p < parts_.size(); ++p) {
+        Part& part = parts_[p];
+        const glm::dmat4 worldFromInstance = worldFromLocal.at(part.root);
+        glm::dvec3 lo(std::numeric_limits<double>::max()), hi = -lo;
+        walkOrgans(part, [&](const Mesh& mesh, const glm::dmat4& instanceFromNode) {
+            for (const glm::dvec3& v : mesh.positions) {
+                const glm::dvec3 q(instanceFromNode * glm::dvec4(v, 1.0));
+                lo = glm::min(lo, q);
+                hi = glm::max(hi, q);
+            }
+            part.leafAreaM2 += MeshArea(mesh, worldFromInstance * instanceFromNode);
+        });
         if (lo.x > hi.x) lo = hi = glm::dvec3(0.0);  // no organ (signatures need a leaf)
         const double pad = std::max(kMinPadM, kPadFraction * glm::length(hi - lo));
         part.boxMin = lo - pad;
         part.boxMax = hi + pad;
-        if (part.leafAreaM2 > 0.0) {
-            auto grid = std::make_shared<AreaGrid>();
-            for (const auto& [centroid, area] : triangles) {
+        if (!(part.leafAreaM2 > 0.0)) continue;
+        auto grid = std::make_shared<AreaGrid>();
+        walkOrgans(part, [&](const Mesh& mesh, const glm::dmat4& instanceFromNode) {
+            const glm::dmat4 worldFromNode = worldFromInstance * instanceFromNode;
+            for (const glm::uvec3& t : mesh.triangles) {
+                const glm::dvec3 centroid(
+                    instanceFromNode *
+                    glm::dvec4(
+                        (mesh.positions[t.x] + mesh.positions[t.y] + mesh.positions[t.z]) / 3.0,
+                        1.0));
                 grid->share[AreaGrid::CellOf(centroid, part.boxMin, part.boxMax)] +=
-                    static_cast<float>(area / part.leafAreaM2);
+                    static_cast<float>(TriangleArea(worldFromNode, mesh, t) / part.leafAreaM2);
             }
-            part.area = std::move(grid);
-        }
+        });
+        part.area = std::move(grid);
     }
 }
 

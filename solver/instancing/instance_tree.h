@@ -37,7 +37,7 @@ class InstanceTree {
         glm::dvec3 boxMin{0.0}, boxMax{0.0};
         double leafAreaM2 = 0.0;
         std::shared_ptr<const AreaGrid> area;  // where in the box that area lies
-        std::int64_t triangles = 0;  // of its own nodes' organs
+        std::int64_t triangles = 0;            // of its own nodes' organs
     };
 
     // `signatures` of a validated scene (ComputeSignatures).

@@ -146,8 +146,8 @@ std::vector<NodeLink> HeldAroundLinks(
             const BoxSpan span = LineThroughBox(points[i], back, sender.boxMin, sender.boxMax);
             if (!span.Meets() || span.exit <= 0.0) continue;
             const double from = std::max(span.enter, 0.0);
-            const Emitters behindPoint = EmittersAlong(sender, points[i], back, from, span.exit,
-                                                       volume);
+            const Emitters behindPoint =
+                EmittersAlong(sender, points[i], back, from, span.exit, volume);
             if (behindPoint.integral <= 0.0) continue;
             // Seen as far as where the light it meets leaves from, on the whole.
             ++rays;

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "solver/raytrace/occlusion.h"
-#include "solver/util/area_grid.h"
 #include "solver/scene/scene.h"
+#include "solver/util/area_grid.h"
 
 namespace leaflux {
 

@@ -43,7 +43,8 @@ std::int64_t WarmStart::Apply(const Hierarchy& hierarchy, const std::vector<Rece
         }
         ++found;
         for (int k = 0; k < sides; ++k)
-            first[r * sides + k] = std::max(0.0, static_cast<double>(light[k]) - first[r * sides + k] / area[r]);
+            first[r * sides + k] =
+                std::max(0.0, static_cast<double>(light[k]) - first[r * sides + k] / area[r]);
     }
     for (std::uint32_t n : leaves) {
         const std::uint32_t r = hierarchy[n].receiver;
