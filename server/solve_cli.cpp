@@ -122,14 +122,14 @@ std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
     const std::int64_t loaded = ResidentBytes(), loadingPeak = PeakRssBytes();
     const bool peakReset = ResetPeakRss();
     // The instanced solver never flattens the scene whole: with shadows by geometry, the
-    // organs' triangles go straight into the ray engine.
+    // scene's triangles go straight into the ray engine.
     const bool instanced = command.solver == "instanced";
     if (!instanced) {
         solved->prepared.emplace(scene);
     } else {
         solved->receivers = ReceiversOf(scene);
         if (ShadowsByGeometry(command.instanced))
-            solved->shadows = OrganRays(scene, solved->receivers);
+            solved->shadows = SceneRays(scene, solved->receivers);
     }
     const FlatScene& flat = solved->Flat();
     SolverSettings settings;

@@ -142,15 +142,21 @@ TEST(RayScene, WrapsAroundAPeriodicTile) {
         rays.Occluded({flat.ToLocal({0.5, 0.1, 0.5})}, glm::normalize(glm::dvec3(0, 1, 0.1))));
 }
 
-TEST(RayScene, OrgansPlacedStraightInTraceAsTheFlatScenesOrgans) {
-    // A tree of placed frames over a ground: the organs written straight into the engine
-    // from the scene (the instanced solver's shadows) against the flat scene's first
-    // triangles, ray by ray, and the receivers without triangles against Flatten's.
+TEST(RayScene, TrianglesPlacedStraightInTraceAsTheFlatScenes) {
+    // A tree of placed frames over a ground: the triangles written straight into the engine
+    // from the scene (the instanced solver's shadows) against the flat scene's, ray by
+    // ray, the organs alone too (OccludedByFirst), and the receivers without triangles
+    // against Flatten's.
     Scene scene = OneBandScene({{"leaf", Leaf(0.1, 0.05)}, {"stem", Opaque(0.2)}});
     TreeParameters tree;
     tree.leafCount = 200;
     AddTree(scene, tree, {40.0, -7.0, 0.0});
     scene.environment.push_back({"ground", Rectangle(6.0, 6.0, 0.0), "stem"});
+    // A ground under the tree, and a wall beside it.
+    scene.environment.push_back(
+        {"ground under it", Quad({34, -13, 0}, {46, -13, 0}, {46, -1, 0}, {34, -1, 0}), "stem"});
+    scene.environment.push_back(
+        {"wall", Quad({42, -13, 0}, {42, -1, 0}, {42, -1, 6}, {42, -13, 6}), "stem"});
     scene.Validate();
     const FlatScene flat = Flatten(scene);
     const FlatScene receivers = ReceiversOf(scene);
@@ -172,9 +178,9 @@ TEST(RayScene, OrgansPlacedStraightInTraceAsTheFlatScenesOrgans) {
     ASSERT_LT(organTriangles, flat.triangles.size());  // the ground is not among them
 
     const RayScene whole(flat, std::nullopt);
-    const std::unique_ptr<RayScene> organs = OrganRays(scene, receivers);
+    const std::unique_ptr<RayScene> placed = SceneRays(scene, receivers);
     Random random(7);
-    int hits = 0, blocked = 0;
+    int hits = 0, blocked = 0, byGround = 0;  // by the organs, and by the ground or wall alone
     for (int i = 0; i < 4000; ++i) {
         // From a point of an organ triangle, or from a point in the crown, any way.
         const std::uint32_t t = static_cast<std::uint32_t>(random.Uniform() * organTriangles);
@@ -188,22 +194,26 @@ TEST(RayScene, OrgansPlacedStraightInTraceAsTheFlatScenesOrgans) {
         const double z = 2.0 * random.Uniform() - 1.0, phi = 2.0 * kPi * random.Uniform();
         const double s = std::sqrt(1.0 - z * z);
         const glm::dvec3 direction(s * std::cos(phi), s * std::sin(phi), z);
-        const bool byOrgans = organs->Occluded(start, direction);
+        const bool occluded = placed->Occluded(start, direction);
+        EXPECT_EQ(occluded, whole.Occluded(start, direction)) << "ray " << i;
+        const bool byOrgans = placed->OccludedByFirst(start, direction, INFINITY, organTriangles);
         EXPECT_EQ(byOrgans, whole.OccludedByFirst(start, direction, INFINITY, organTriangles))
             << "ray " << i;
         blocked += byOrgans;
-        const RayHit hit = organs->Trace(start, direction);
+        byGround += occluded && !byOrgans;
+        const RayHit hit = placed->Trace(start, direction);
         hits += hit.fate == RayFate::kHit;
-        // Where the flat scene's first hit is an organ's, the same triangle as far.
-        if (const RayHit first = whole.Trace(start, direction);
-            first.fate == RayFate::kHit && first.triangle < organTriangles) {
+        const RayHit first = whole.Trace(start, direction);
+        EXPECT_EQ(hit.fate, first.fate) << "ray " << i;
+        if (first.fate == RayFate::kHit) {
             EXPECT_EQ(hit.triangle, first.triangle) << "ray " << i;
             EXPECT_EQ(hit.distance, first.distance) << "ray " << i;
         }
     }
+    EXPECT_GT(byGround, 100);  // the ground and the wall are in the engine
     EXPECT_GT(blocked, 100);
     EXPECT_LT(blocked, 3900);
-    EXPECT_EQ(hits, blocked);
+    EXPECT_EQ(hits, blocked + byGround);
 }
 
 }  // namespace

@@ -357,12 +357,11 @@ bool RayScene::Occluded(const RayStart& start, const glm::dvec3& direction,
     return false;
 }
 
-std::unique_ptr<RayScene> OrganRays(const Scene& scene, const FlatScene& receivers) {
-    std::uint32_t organs = 0;
-    for (const Receiver& receiver : receivers.receivers)
-        if (receiver.kind == ReceiverKind::kOrgan) organs += receiver.triangleCount;
-    return std::make_unique<RayScene>(receivers, organs,
-                                      [&](float* xyz) { PlaceOrgans(scene, receivers, xyz); });
+std::unique_ptr<RayScene> SceneRays(const Scene& scene, const FlatScene& receivers) {
+    std::uint32_t triangles = 0;
+    for (const Receiver& receiver : receivers.receivers) triangles += receiver.triangleCount;
+    return std::make_unique<RayScene>(receivers, triangles,
+                                      [&](float* xyz) { PlaceTriangles(scene, receivers, xyz); });
 }
 
 }  // namespace leaflux

@@ -74,8 +74,8 @@ class RayScene {
              std::shared_ptr<RayDevice> device = RayDevice::Shared(),
              std::uint32_t triangles = kNoTriangle);
     // Over `triangles` triangles that `place` writes, 9 floats each, in the frame of
-    // `frame` (origin, bounds; its triangles unused): the whole scene's organs without a
-    // flat scene of them (PlaceOrgans). Not periodic.
+    // `frame` (origin, bounds; its triangles unused): the whole scene's triangles without a
+    // flat scene of them (PlaceTriangles). Not periodic.
     RayScene(const FlatScene& frame, std::uint32_t triangles,
              const std::function<void(float*)>& place,
              std::shared_ptr<RayDevice> device = RayDevice::Shared());
@@ -144,9 +144,11 @@ class RayScene {
     RTCScene top_ = nullptr;   // the triangles, or 9 instances of them in a periodic scene
 };
 
-// The scene's organs alone in a ray engine, in the frame of `receivers` (ReceiversOf the
-// scene), placed straight into it: the instanced solver's exact shadows without a flat
-// scene of the triangles in double precision.
-std::unique_ptr<RayScene> OrganRays(const Scene& scene, const FlatScene& receivers);
+// The scene's triangles in a ray engine, numbered as Flatten numbers them, in the frame of
+// `receivers` (ReceiversOf the scene), placed straight into it: the instanced solver's
+// exact shadows without a flat scene of the triangles in double precision. Its organs come
+// first; walls, roofs and the ground shade the organs and one another as in the flat
+// scene's engine (the organs alone, a room's leaves took the sky through its walls).
+std::unique_ptr<RayScene> SceneRays(const Scene& scene, const FlatScene& receivers);
 
 }  // namespace leaflux

@@ -103,11 +103,9 @@ FlatScene Flatten(const Scene& scene, const PlacedOrgans& placed) {
     return FlattenScene(scene, placed, true);
 }
 
-void PlaceOrgans(const Scene& scene, const FlatScene& receivers, float* xyz) {
-    const auto worldFromLocal = WorldFromLocal(scene);
-    for (const Node& node : scene.nodes) {
-        if (!node.organ) continue;
-        for (const Triangle& t : PlaceMesh(*node.organ->mesh, worldFromLocal.at(node.id))) {
+void PlaceTriangles(const Scene& scene, const FlatScene& receivers, float* xyz) {
+    const auto write = [&](const std::vector<Triangle>& placed) {
+        for (const Triangle& t : placed) {
             for (const glm::dvec3& corner : {t.a, t.b, t.c}) {
                 const glm::dvec3 local = corner - receivers.origin;
                 *xyz++ = static_cast<float>(local.x);
@@ -115,7 +113,15 @@ void PlaceOrgans(const Scene& scene, const FlatScene& receivers, float* xyz) {
                 *xyz++ = static_cast<float>(local.z);
             }
         }
+    };
+    const auto worldFromLocal = WorldFromLocal(scene);
+    for (const Node& node : scene.nodes) {
+        if (node.organ) write(PlaceMesh(*node.organ->mesh, worldFromLocal.at(node.id)));
     }
+    for (const Surface& surface : scene.environment)
+        write(PlaceMesh(*surface.mesh, glm::dmat4(1.0)));
+    for (const Emitter& emitter : scene.sources.emitters)
+        write(PlaceMesh(*emitter.mesh, glm::dmat4(1.0)));
 }
 
 }  // namespace leaflux

@@ -58,9 +58,10 @@ FlatScene Flatten(const Scene& scene);
 // triangle ranges, and the frame (origin, bounds). What per-receiver results are indexed by
 // when the scene is never flattened whole (the instanced solver).
 FlatScene ReceiversOf(const Scene& scene);
-// The organs' triangles as Flatten would place them, straight into 9 floats each, in the
-// frame of `receivers` (ReceiversOf the scene): a ray engine's without the flat scene.
-void PlaceOrgans(const Scene& scene, const FlatScene& receivers, float* xyz);
+// Every triangle as Flatten would place it (the organs', then the environment's and the
+// emitters'), straight into 9 floats each, in the frame of `receivers` (ReceiversOf the
+// scene): a ray engine's without the flat scene.
+void PlaceTriangles(const Scene& scene, const FlatScene& receivers, float* xyz);
 
 // A mesh's triangles placed by worldFromLocal, in world coordinates (receiver 0).
 std::vector<Triangle> PlaceMesh(const Mesh& mesh, const glm::dmat4& worldFromLocal);
