@@ -95,7 +95,11 @@ class InstancedSolve {
     void Run() {
         const std::unique_ptr<Level> top = Build(InstanceTree::kTop, glm::dmat4(1.0), nullptr, 0);
         LevelSolution light = Solve(InstanceTree::kTop, *top, {});
-        if (!options_.holdOutside && !options_.hrc.directOnly) held_ = Emitters(light.surfaces);
+        if (options_.hrc.directOnly) {
+            held_ = Lamps();
+        } else if (!options_.holdOutside) {
+            held_ = Emitters(light.surfaces);
+        }
         errorW_ = light.errorW;
         sourceCount_ = light.sourceCount;
         OpenInstances(*top, light);
@@ -104,8 +108,8 @@ class InstancedSolve {
   private:
     static constexpr std::uint32_t kNoReceiver = 0xFFFFFFFFu;
 
-    // Direct light alone: an opened instance takes the suns and sky alone, not what the
-    // levels it lies in scattered (held, or per bin).
+    // Direct light alone: an opened instance takes the suns, sky and lamps alone, not what
+    // the levels it lies in scattered (held, or per bin).
     static InstancedOptions DirectOnlyAlone(InstancedOptions options) {
         if (options.hrc.directOnly) options.holdOutside = false;
         return options;
@@ -151,6 +155,12 @@ class InstancedSolve {
     std::vector<DirectionalSource> ArrivedOn(const LevelSolution& light, std::size_t c) const;
     // Each patch side that sends light, as an emitter held fixed (ReceiverKind::kHeld).
     static std::vector<Emitter> Emitters(const std::vector<LevelSolution::SurfacePatch>& patches);
+    // The scene's lamps, held: what they emit, not what they reflect (direct light alone).
+    std::vector<Emitter> Lamps() const {
+        std::vector<Emitter> lamps = scene_.sources.emitters;
+        for (Emitter& lamp : lamps) lamp.held = true;
+        return lamps;
+    }
     void OpenInstances(const Level& level, const LevelSolution& light);
     // Whether part q, placed by worldFromRoot, is opened (InstancedOptions::maxDepth,
     // outputLevel, inView).
