@@ -22,31 +22,27 @@ LIT = 0.05
 
 
 def load(path):
-    """Leaf irradiance (both sides, W/m²) by (organ, band)."""
+    """Leaf area (m²) and irradiance on its upper and lower sides (W/m²) by (organ, band)."""
     values = {}
     for row in csv.DictReader(open(path)):
         if row["organ"].startswith("leaf"):
-            values[(row["organ"], row["band"])] = (float(row["irradiance_upper_wm2"]) +
+            values[(row["organ"], row["band"])] = (float(row["area_m2"]),
+                                                   float(row["irradiance_upper_wm2"]),
                                                    float(row["irradiance_lower_wm2"]))
     return values
 
 
-def load_sides(path):
-    """Leaf area (m²) and the power on its upper and lower sides (W) by (organ, band)."""
-    values = {}
-    for row in csv.DictReader(open(path)):
-        if row["organ"].startswith("leaf"):
-            area = float(row["area_m2"])
-            values[(row["organ"], row["band"])] = (area * float(row["irradiance_upper_wm2"]),
-                                                   area * float(row["irradiance_lower_wm2"]))
-    return values
+def both_sides(leaves):
+    """Leaf irradiance, both sides together (W/m²), by (organ, band)."""
+    return {k: upper + lower for k, (_, upper, lower) in leaves.items()}
 
 
 def sides_against(reference, value, band):
     """(upper, lower): what all the leaves' sides take, in % off the reference's."""
     keys = [k for k in reference if k[1] == band]
-    return tuple(100 * (sum(value[k][s] for k in keys) / sum(reference[k][s] for k in keys) - 1)
-                 for s in (0, 1))
+    return tuple(100 * (sum(value[k][0] * value[k][s] for k in keys) /
+                        sum(reference[k][0] * reference[k][s] for k in keys) - 1)
+                 for s in (1, 2))
 
 
 def errors(reference, value, band):
@@ -122,13 +118,13 @@ def main():
                         help="with --scene: the least leaves a structure holds (default 11, "
                              "the default policy's smallest instance)")
     args = parser.parse_args()
-    reference, value = load(args.reference), load(args.other)
-    reference_sides, value_sides = load_sides(args.reference), load_sides(args.other)
+    reference_leaves, value_leaves = load(args.reference), load(args.other)
+    reference, value = both_sides(reference_leaves), both_sides(value_leaves)
     holder = structure_of_leaves(args.scene, args.by, args.min_leaves) if args.scene else None
     for band in sorted({k[1] for k in reference}):
         l2, mean, p95 = errors(reference, value, band)
         print(f"{band}: L2 {l2:.2f} % of max, mean relative {mean:.2f} %, 95th percentile {p95:.2f} %")
-        upper, lower = sides_against(reference_sides, value_sides, band)
+        upper, lower = sides_against(reference_leaves, value_leaves, band)
         print(f"{band}: all upper sides {upper:+.2f} %, all lower sides {lower:+.2f} % "
               f"against the reference")
         fifths = " ".join(f"{b:+.2f}" for b in bias_by_fifth(reference, value, band))

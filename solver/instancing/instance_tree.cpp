@@ -1,6 +1,7 @@
 #include "solver/instancing/instance_tree.h"
 
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <unordered_map>
 
@@ -57,8 +58,8 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
             parts_[part.parent].instances.push_back(owner[i]);
     }
     // Boxes, areas and where the areas lie over each instance's whole subtree, in its own
-    // frame: the box first, then the area cell by cell (two walks, so that nothing the
-    // size of the subtree is kept).
+    // frame: the box first, then each triangle's area into its cell (two walks, so that
+    // nothing the size of the subtree is kept).
     const auto worldFromLocal = WorldFromLocal(scene);
     const auto walkOrgans = [&](const Part& part, const auto& visit) {
         std::vector<std::pair<std::size_t, glm::dmat4>> walk{{part.rootIndex, glm::dmat4(1.0)}};
@@ -70,9 +71,9 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
                 walk.push_back({c, instanceFromNode * scene.nodes[c].parentFromLocal});
         }
     };
+    std::array<double, AreaGrid::kCount> cells;
     for (std::uint32_t p = 1; p < parts_.size(); ++p) {
         Part& part = parts_[p];
-        const glm::dmat4 worldFromInstance = worldFromLocal.at(part.root);
         glm::dvec3 lo(std::numeric_limits<double>::max()), hi = -lo;
         walkOrgans(part, [&](const Mesh& mesh, const glm::dmat4& instanceFromNode) {
             for (const glm::dvec3& v : mesh.positions) {
@@ -80,14 +81,13 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
                 lo = glm::min(lo, q);
                 hi = glm::max(hi, q);
             }
-            part.leafAreaM2 += MeshArea(mesh, worldFromInstance * instanceFromNode);
         });
         if (lo.x > hi.x) lo = hi = glm::dvec3(0.0);  // no organ (signatures need a leaf)
         const double pad = std::max(kMinPadM, kPadFraction * glm::length(hi - lo));
         part.boxMin = lo - pad;
         part.boxMax = hi + pad;
-        if (!(part.leafAreaM2 > 0.0)) continue;
-        auto grid = std::make_shared<AreaGrid>();
+        const glm::dmat4 worldFromInstance = worldFromLocal.at(part.root);
+        cells.fill(0.0);
         walkOrgans(part, [&](const Mesh& mesh, const glm::dmat4& instanceFromNode) {
             const glm::dmat4 worldFromNode = worldFromInstance * instanceFromNode;
             for (const glm::uvec3& t : mesh.triangles) {
@@ -96,10 +96,15 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
                     glm::dvec4(
                         (mesh.positions[t.x] + mesh.positions[t.y] + mesh.positions[t.z]) / 3.0,
                         1.0));
-                grid->share[AreaGrid::CellOf(centroid, part.boxMin, part.boxMax)] +=
-                    static_cast<float>(TriangleArea(worldFromNode, mesh, t) / part.leafAreaM2);
+                const double area = TriangleArea(worldFromNode, mesh, t);
+                cells[AreaGrid::CellOf(centroid, part.boxMin, part.boxMax)] += area;
+                part.leafAreaM2 += area;
             }
         });
+        if (!(part.leafAreaM2 > 0.0)) continue;
+        auto grid = std::make_shared<AreaGrid>();
+        for (int c = 0; c < AreaGrid::kCount; ++c)
+            grid->share[c] = static_cast<float>(cells[c] / part.leafAreaM2);
         part.area = std::move(grid);
     }
 }
