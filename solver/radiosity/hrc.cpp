@@ -325,8 +325,9 @@ void SceneSolve::Index() {
         const Receiver& receiver = flat_.receivers[node.receiver];
         if (receiver.kind != ReceiverKind::kEmitter && receiver.kind != ReceiverKind::kHeld)
             continue;
-        const auto& exitance = scene_.sources.emitters[receiver.emitter].exitanceWm2;
-        for (int b = 0; b < channels_.bands; ++b) leafLight_.emission[n][b] = exitance[b];
+        const Emitter& emitter = scene_.sources.emitters[receiver.emitter];
+        const std::size_t t = node.triangle - receiver.firstTriangle;
+        for (int b = 0; b < channels_.bands; ++b) leafLight_.emission[n][b] = emitter.Exitance(t, b);
     }
 }
 
@@ -641,7 +642,8 @@ void SceneSolve::Arrived(LevelSolution& level) const {
         const double* lower = field_.radiosity(n, kLower);
         level.surfaces.push_back({node.a + o, node.b + o, node.c + o,
                                   std::vector<double>(upper, upper + channels_.Count()),
-                                  std::vector<double>(lower, lower + channels_.Count())});
+                                  std::vector<double>(lower, lower + channels_.Count()),
+                                  node.receiver, model_.Lamp(n)});
     }
 }
 
@@ -668,7 +670,8 @@ void SceneSolve::HandOnOrgans(LevelSolution& level) const {
         for (double& b : sides) b /= light.first;
         level.surfaces.push_back({triangle.a + o, triangle.b + o, triangle.c + o,
                                   std::vector<double>(sides.begin(), sides.begin() + count),
-                                  std::vector<double>(sides.begin() + count, sides.end())});
+                                  std::vector<double>(sides.begin() + count, sides.end()),
+                                  triangle.receiver});
     }
 }
 

@@ -196,6 +196,8 @@ struct LevelSolution {
     struct SurfacePatch {
         glm::dvec3 a, b, c;                // world frame; the upper side by a, b, c
         std::vector<double> upper, lower;  // exitance per channel (W/m²)
+        std::uint32_t surface = 0;         // the level's receiver it is part of
+        bool lamp = false;                 // a piece of a black lamp (NodeModel::Lamp)
     };
     std::vector<SurfacePatch> surfaces;
     // With LevelProblem::holdLevel: per closed instance (not held), its intensity as solved,

@@ -81,7 +81,11 @@ void NodeModel::FindOnward(const Scene& scene) {
     lampOf_.assign(flat_.receivers.size(), 0);
     for (std::size_t r = 0; r < flat_.receivers.size(); ++r) {
         const Receiver& receiver = flat_.receivers[r];
-        lampOf_[r] = receiver.kind == ReceiverKind::kEmitter && receiver.optics < 0;
+        // A black lamp, or held from one (Emitter::lamp).
+        lampOf_[r] = receiver.optics < 0 &&
+                     (receiver.kind == ReceiverKind::kEmitter ||
+                      (receiver.kind == ReceiverKind::kHeld &&
+                       scene.sources.emitters[receiver.emitter].lamp));
         if (receiver.kind == ReceiverKind::kOrgan) {
             onwardOf_[r] = 1.0f;
             continue;

@@ -80,6 +80,16 @@ struct Emitter {
     std::string opticsId;              // empty: black (absorbs all it receives)
     // A surface outside a local problem, its radiosity held (ReceiverKind::kHeld).
     bool held = false;
+    // Held, pieces of a black lamp: its light is its exitance, even over each (NodeModel::Lamp).
+    bool lamp = false;
+    // Held: per triangle of the mesh, per band, what each sends (empty: exitanceWm2 all over).
+    std::vector<double> triangleExitanceWm2;
+
+    // What triangle t of the mesh sends in band b (W/m²).
+    double Exitance(std::size_t t, std::size_t b) const {
+        return triangleExitanceWm2.empty() ? exitanceWm2[b]
+                                           : triangleExitanceWm2[t * exitanceWm2.size() + b];
+    }
 };
 
 struct Sources {
