@@ -64,7 +64,8 @@ SCENES = {
                     "--row-spacing", "1.4", "--leaves", "200", "--leaf-length", "0.06"],
                    "greenhouse at night: 24 plants of 200 leaves, white floor and walls, "
                    "three lamp bars, no roof",
-                   ["--reference-samples", "4096", "--hrc-epsilon", "1e-3,1e-4,1e-5,1e-6,3e-7"]),
+                   ["--reference-samples", "4096", "--hrc-epsilon", "1e-3,1e-4,1e-5,1e-6,3e-7",
+                    "--instanced-epsilon", "1e-3,1e-4,1e-5"]),
 }
 
 

@@ -389,9 +389,9 @@ std::vector<Emitter> InstancedSolve::Emitters(
             Emitter& emitter = held[at->second];
             Mesh& mesh = meshes[at->second];
             const auto first = static_cast<std::uint32_t>(mesh.positions.size());
-            mesh.positions.insert(mesh.positions.end(),
-                                  {patch.a, side == kUpper ? patch.b : patch.c,
-                                   side == kUpper ? patch.c : patch.b});
+            mesh.positions.insert(
+                mesh.positions.end(),
+                {patch.a, side == kUpper ? patch.b : patch.c, side == kUpper ? patch.c : patch.b});
             mesh.triangles.push_back({first, first + 1, first + 2});
             emitter.triangleExitanceWm2.insert(emitter.triangleExitanceWm2.end(), exitance.begin(),
                                                exitance.end());

@@ -224,6 +224,22 @@ class SceneSolve {
     std::int64_t WarmLeaves();
     // Jacobi from the emission, then refine–solve passes until no link needs refining.
     void Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock);
+    // At the scene's top, on the first arrival (the lamps' light: the suns' and sky's reach
+    // the closed instances by their own links, counted where those are opened or solved
+    // whole): what the closed instances intercept of it, by their area less τ per bin.
+    void ClosedLampIncident() {
+        if (!Closed() || HoldsOutside() || occlusion_.HasOutside()) return;
+        const int count = channels_.Count();
+        closedLampIncident_.assign(count, 0.0);
+        for (std::size_t c = 0; c < hierarchy_.Closed().size(); ++c) {
+            const std::uint32_t n = hierarchy_.NodeOfClosed(static_cast<std::int32_t>(c));
+            for (int d = 0; d < model_.BinCount(); ++d) {
+                for (int k = 0; k < count; ++k)
+                    closedLampIncident_[k] +=
+                        closedLight_.bins[c][d * count + k] * model_.ProjectedBin(n, d);
+            }
+        }
+    }
     ClosedLight* Closed() { return hierarchy_.Closed().empty() ? nullptr : &closedLight_; }
     // The radiosity of the leaf patches and the light the closed instances send, from what
     // arrived: the largest change over the largest value.
@@ -282,6 +298,9 @@ class SceneSolve {
     const ReceiverOptics optics_;
     const std::vector<DirectionalSource> sources_;
     ClosedLight closedLight_;
+    // At the scene's top: per channel, the lamps' light the closed instances intercepted on
+    // its first arrival (ClosedLampIncident), incident light no level counts otherwise.
+    std::vector<double> closedLampIncident_;
     std::optional<ClosedResponse> closedResponse_;  // made on the first update
     const std::unique_ptr<const Occlusion> ownOcclusion_;
     const Occlusion& occlusion_;
@@ -327,7 +346,8 @@ void SceneSolve::Index() {
             continue;
         const Emitter& emitter = scene_.sources.emitters[receiver.emitter];
         const std::size_t t = node.triangle - receiver.firstTriangle;
-        for (int b = 0; b < channels_.bands; ++b) leafLight_.emission[n][b] = emitter.Exitance(t, b);
+        for (int b = 0; b < channels_.bands; ++b)
+            leafLight_.emission[n][b] = emitter.Exitance(t, b);
     }
 }
 
@@ -487,6 +507,7 @@ void SceneSolve::Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock)
                     std::any_of(sources_.begin(), sources_.end(),
                                 [](const DirectionalSource& s) { return !s.incident; }))
                     leafLight_.direct = sourceLight_.incident;
+                ClosedLampIncident();
                 warmed = WarmLeaves();
                 solution.stats.warmOrgans = warmed;
             }
@@ -605,6 +626,8 @@ void SceneSolve::Outputs(Solution& solution) {
     rayCount_ += WriteOutputs(model_, rays_, traversal_.Leaves(), optics_, field_, leafLight_, sink,
                               solution.balance, top ? &occlusion_ : nullptr);
     if (top) rayCount_ += AddClosedEscape(model_, occlusion_, field_, solution.balance);
+    for (std::size_t k = 0; k < closedLampIncident_.size(); ++k)
+        solution.balance[k].incidentW += closedLampIncident_[k];
 }
 
 void SceneSolve::Arrived(LevelSolution& level) const {

@@ -82,10 +82,9 @@ void NodeModel::FindOnward(const Scene& scene) {
     for (std::size_t r = 0; r < flat_.receivers.size(); ++r) {
         const Receiver& receiver = flat_.receivers[r];
         // A black lamp, or held from one (Emitter::lamp).
-        lampOf_[r] = receiver.optics < 0 &&
-                     (receiver.kind == ReceiverKind::kEmitter ||
-                      (receiver.kind == ReceiverKind::kHeld &&
-                       scene.sources.emitters[receiver.emitter].lamp));
+        lampOf_[r] = receiver.optics < 0 && (receiver.kind == ReceiverKind::kEmitter ||
+                                             (receiver.kind == ReceiverKind::kHeld &&
+                                              scene.sources.emitters[receiver.emitter].lamp));
         if (receiver.kind == ReceiverKind::kOrgan) {
             onwardOf_[r] = 1.0f;
             continue;
