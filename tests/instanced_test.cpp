@@ -364,7 +364,7 @@ void ExpectLowerSidesNearFlattened(const Scene& scene, const std::vector<double>
 // centre sees of it, and an opened instance holds the ground to take it so. The ground's
 // light held per bin over the instance gave the lower sides 7.6 % (PAR) and 6.8 % (NIR)
 // more than the flattened scene's HRC, at ε = 1e-4 as at 1e-5; held as a sender, −2.3 %
-// and −2.3 % at 1e-5 (the test prints them; −7.8 % and −7.2 % at 1e-4, where the held
+// and −2.3 % at 1e-5 (the test prints them; −7.3 % and −6.8 % at 1e-4, where the held
 // ground's links are coarser than HRC's, which is within 0.9 % at 1e-4). Bound: 3 %.
 TEST(Instanced, AShadedGroundLightsTheLowerSidesFromUnderThem) {
     Scene scene = Copies(1, 300);
