@@ -118,4 +118,18 @@ void DarkenClosed(const NodeModel& model, Field& field) {
     }
 }
 
+std::vector<double> InterceptedByClosed(const NodeModel& model, const ClosedLight& arrived) {
+    const Hierarchy& hierarchy = model.Nodes();
+    const int count = model.ChannelSet().Count();
+    std::vector<double> power(count, 0.0);
+    for (std::size_t c = 0; c < hierarchy.Closed().size(); ++c) {
+        const std::uint32_t n = hierarchy.NodeOfClosed(static_cast<std::int32_t>(c));
+        for (int d = 0; d < model.BinCount(); ++d) {
+            for (int k = 0; k < count; ++k)
+                power[k] += arrived.bins[c][d * count + k] * model.ProjectedBin(n, d);
+        }
+    }
+    return power;
+}
+
 }  // namespace leaflux

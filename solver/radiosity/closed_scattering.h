@@ -43,4 +43,8 @@ void HoldClosed(const NodeModel& model, Field& field);
 // to nothing: the field before any light arrived.
 void DarkenClosed(const NodeModel& model, Field& field);
 
+// Per channel, the power the closed instances intercept of the light that arrived on them
+// per bin (`arrived`): each bin's irradiance times the box's section less τ that way.
+std::vector<double> InterceptedByClosed(const NodeModel& model, const ClosedLight& arrived);
+
 }  // namespace leaflux

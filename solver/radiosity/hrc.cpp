@@ -226,19 +226,10 @@ class SceneSolve {
     void Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock);
     // At the scene's top, on the first arrival (the lamps' light: the suns' and sky's reach
     // the closed instances by their own links, counted where those are opened or solved
-    // whole): what the closed instances intercept of it, by their area less τ per bin.
+    // whole): what the closed instances intercept of it.
     void ClosedLampIncident() {
-        if (!Closed() || HoldsOutside() || occlusion_.HasOutside()) return;
-        const int count = channels_.Count();
-        closedLampIncident_.assign(count, 0.0);
-        for (std::size_t c = 0; c < hierarchy_.Closed().size(); ++c) {
-            const std::uint32_t n = hierarchy_.NodeOfClosed(static_cast<std::int32_t>(c));
-            for (int d = 0; d < model_.BinCount(); ++d) {
-                for (int k = 0; k < count; ++k)
-                    closedLampIncident_[k] +=
-                        closedLight_.bins[c][d * count + k] * model_.ProjectedBin(n, d);
-            }
-        }
+        if (Closed() && !HoldsOutside() && !occlusion_.HasOutside())
+            closedLampIncident_ = InterceptedByClosed(model_, closedLight_);
     }
     ClosedLight* Closed() { return hierarchy_.Closed().empty() ? nullptr : &closedLight_; }
     // The radiosity of the leaf patches and the light the closed instances send, from what
