@@ -29,26 +29,43 @@ struct Flattening {
     }
 };
 
+// Each receiver of the scene in the flat scene's order — the organs, the environment's
+// surfaces, the emitters — as visit(its triangles placed in the world, a function making
+// its Receiver).
+template <class Visit>
+void ForEachReceiver(const Scene& scene, const PlacedOrgans& placed, const Visit& visit) {
+    for (const Node& node : scene.nodes) {
+        if (!node.organ) continue;
+        visit(placed(node), [&] {
+            return Receiver{scene.NodeName(node), ReceiverKind::kOrgan, node.id,
+                            scene.OpticsIndex(node.organ->opticsId)};
+        });
+    }
+    for (const Surface& surface : scene.environment) {
+        visit(PlaceMesh(*surface.mesh, glm::dmat4(1.0)), [&] {
+            return Receiver{surface.name, ReceiverKind::kEnvironment, 0,
+                            scene.OpticsIndex(surface.opticsId)};
+        });
+    }
+    for (std::size_t e = 0; e < scene.sources.emitters.size(); ++e) {
+        const Emitter& emitter = scene.sources.emitters[e];
+        visit(PlaceMesh(*emitter.mesh, glm::dmat4(1.0)), [&] {
+            return Receiver{emitter.name,
+                            emitter.held ? ReceiverKind::kHeld : ReceiverKind::kEmitter, 0,
+                            emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId),
+                            static_cast<int>(e)};
+        });
+    }
+}
+
 // Flatten, with or without the triangles.
 FlatScene FlattenScene(const Scene& scene, const PlacedOrgans& placed, bool keep) {
     Flattening out;
     out.keep = keep;
-    for (const Node& node : scene.nodes) {
-        if (!node.organ) continue;
-        out.Add(placed(node), {scene.NodeName(node), ReceiverKind::kOrgan, node.id,
-                               scene.OpticsIndex(node.organ->opticsId)});
-    }
-    for (const Surface& surface : scene.environment) {
-        out.Add(PlaceMesh(*surface.mesh, glm::dmat4(1.0)),
-                {surface.name, ReceiverKind::kEnvironment, 0, scene.OpticsIndex(surface.opticsId)});
-    }
-    for (std::size_t e = 0; e < scene.sources.emitters.size(); ++e) {
-        const Emitter& emitter = scene.sources.emitters[e];
-        out.Add(PlaceMesh(*emitter.mesh, glm::dmat4(1.0)),
-                {emitter.name, emitter.held ? ReceiverKind::kHeld : ReceiverKind::kEmitter, 0,
-                 emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId),
-                 static_cast<int>(e)});
-    }
+    ForEachReceiver(scene, placed,
+                    [&](const std::vector<Triangle>& triangles, const auto& receiver) {
+                        out.Add(triangles, receiver());
+                    });
     FlatScene& flat = out.flat;
     if (out.count == 0) return flat;
     flat.origin = 0.5 * (out.lo + out.hi);
@@ -104,24 +121,18 @@ FlatScene Flatten(const Scene& scene, const PlacedOrgans& placed) {
 }
 
 void PlaceTriangles(const Scene& scene, const FlatScene& receivers, float* xyz) {
-    const auto write = [&](const std::vector<Triangle>& placed) {
-        for (const Triangle& t : placed) {
-            for (const glm::dvec3& corner : {t.a, t.b, t.c}) {
-                const glm::dvec3 local = corner - receivers.origin;
-                *xyz++ = static_cast<float>(local.x);
-                *xyz++ = static_cast<float>(local.y);
-                *xyz++ = static_cast<float>(local.z);
-            }
-        }
-    };
-    const auto worldFromLocal = WorldFromLocal(scene);
-    for (const Node& node : scene.nodes) {
-        if (node.organ) write(PlaceMesh(*node.organ->mesh, worldFromLocal.at(node.id)));
-    }
-    for (const Surface& surface : scene.environment)
-        write(PlaceMesh(*surface.mesh, glm::dmat4(1.0)));
-    for (const Emitter& emitter : scene.sources.emitters)
-        write(PlaceMesh(*emitter.mesh, glm::dmat4(1.0)));
+    std::vector<Triangle> placed;
+    ForEachReceiver(scene, PlacedByFrame(scene, placed),
+                    [&](const std::vector<Triangle>& triangles, const auto&) {
+                        for (const Triangle& t : triangles) {
+                            for (const glm::dvec3& corner : {t.a, t.b, t.c}) {
+                                const glm::dvec3 local = corner - receivers.origin;
+                                *xyz++ = static_cast<float>(local.x);
+                                *xyz++ = static_cast<float>(local.y);
+                                *xyz++ = static_cast<float>(local.z);
+                            }
+                        }
+                    });
 }
 
 }  // namespace leaflux
