@@ -353,8 +353,12 @@ void CheckPeriodicTile(const Scene& scene, const FlatScene& flat, const SceneLim
     }
 }
 
-Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
-                const SceneLimits& limits, const ImportOptions& options) {
+namespace {
+
+// FromProto but for the check of the whole (Scene::Validate), which a caller that owns the
+// message does once the message is gone.
+Scene UncheckedFromProto(const v1::Scene& message, const std::string& baseDirectory,
+                         const SceneLimits& limits, const ImportOptions& options) {
     if (message.version() > v1::PROTOCOL_VERSION_CURRENT) {
         Fail(ErrorCode::kUnsupported, "version", "is newer than this leaflux understands");
     }
@@ -373,7 +377,8 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
                                     " nodes a scene (--max-nodes), got " +
                                     std::to_string(message.nodes_size()));
     }
-    CountPlacedNodes(message, static_cast<std::size_t>(message.nodes_size()), limits);
+    const std::size_t placedNodes =
+        CountPlacedNodes(message, static_cast<std::size_t>(message.nodes_size()), limits);
     const std::filesystem::path base(baseDirectory);
     Scene scene;
     std::unordered_set<std::string> bandNames;
@@ -408,6 +413,9 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
         scene.optics.push_back(std::move(o));
     }
     const MeshLibrary meshes = MeshesFromProto(message);
+    // Exactly as many as there will be: grown by doubling, the nodes of a plantation of 233
+    // trees took 310 MB for 160.
+    scene.nodes.reserve(static_cast<std::size_t>(message.nodes_size()) + placedNodes);
     for (const v1::Node& in : message.nodes()) scene.nodes.push_back(NodeFromProto(in, meshes));
     ExpandPlacements(message, meshes, scene.nodes);
     for (const v1::Surface& surface : message.environment()) {
@@ -422,6 +430,14 @@ Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
         scene.periodic = PeriodicDomain{p.x_min(), p.y_min(), p.x_max(), p.y_max()};
     }
     ReadImports(message, scene, base, options);
+    return scene;
+}
+
+}  // namespace
+
+Scene FromProto(const v1::Scene& message, const std::string& baseDirectory,
+                const SceneLimits& limits, const ImportOptions& options) {
+    Scene scene = UncheckedFromProto(message, baseDirectory, limits, options);
     scene.Validate();
     return scene;
 }
@@ -501,17 +517,26 @@ bool IsBinarySceneFile(const std::string& path) {
 
 Scene LoadSceneFile(const std::string& path, const ImportOptions& options,
                     const SceneLimits& limits) {
-    v1::Scene message;
-    if (IsBinarySceneFile(path)) {
-        std::ifstream in(path, std::ios::binary);
-        if (!in) Fail(ErrorCode::kIo, path, "cannot open the scene file");
-        if (!message.ParseFromIstream(&in))
-            Fail(ErrorCode::kParse, path, "is not a binary leaflux.v1.Scene");
-    } else if (const auto error = ReadTextFormat(path, message)) {
-        Fail(error->unreadable ? ErrorCode::kIo : ErrorCode::kParse, error->where,
-             error->unreadable ? "cannot open the scene file" : error->what);
+    Scene scene;
+    {
+        v1::Scene message;
+        if (IsBinarySceneFile(path)) {
+            std::ifstream in(path, std::ios::binary);
+            if (!in) Fail(ErrorCode::kIo, path, "cannot open the scene file");
+            if (!message.ParseFromIstream(&in))
+                Fail(ErrorCode::kParse, path, "is not a binary leaflux.v1.Scene");
+        } else if (const auto error = ReadTextFormat(path, message)) {
+            Fail(error->unreadable ? ErrorCode::kIo : ErrorCode::kParse, error->where,
+                 error->unreadable ? "cannot open the scene file" : error->what);
+        }
+        scene = UncheckedFromProto(message, std::filesystem::path(path).parent_path().string(),
+                                   limits, options);
     }
-    return FromProto(message, std::filesystem::path(path).parent_path().string(), limits, options);
+    // Checked once the file's message is freed: the check's tables of every node's frame
+    // and name, beside the message and the scene, made the reading's peak (627 MiB for a
+    // plantation of 233 trees read from 81 MB of binary).
+    scene.Validate();
+    return scene;
 }
 
 void SaveSceneFile(const Scene& scene, const std::string& path, SceneWriting writing) {

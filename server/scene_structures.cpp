@@ -231,8 +231,9 @@ void ExpandPlacements(const v1::Scene& message, const MeshLibrary& meshes,
                             field + " (in " + job.field + ")"});
         }
     }
-    std::stable_sort(nodes.begin(), nodes.end(),
-                     [](const Node& a, const Node& b) { return a.id < b.id; });
+    // In place: the ids are unique (`used`), so no order of equals to keep, and no buffer of
+    // half the nodes as a stable sort takes (80 MB for 233 placed trees).
+    std::sort(nodes.begin(), nodes.end(), [](const Node& a, const Node& b) { return a.id < b.id; });
 }
 
 // ---- Writing --------------------------------------------------------------------------
