@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 
 #include "solver/util/box.h"
 
@@ -34,18 +35,42 @@ Emitters EmittersAlong(const ClosedNode& sender, const glm::dvec3& x, const glm:
                        double from, double to, double volume) {
     const double length = to - from;
     if (!sender.organArea) return {length / volume, from + 0.5 * length};
-    // Midpoints of steps a quarter of a cell's side at most where the line is longest.
-    constexpr int kSteps = 4 * AreaGrid::kCells;
-    constexpr double kCellVolumes = AreaGrid::kCount;
-    const double step = length / kSteps;
+    // The density is constant in each cell: the line walked cell by cell (Amanatides & Woo
+    // 1987), each piece taken whole. Exact, and at most 3 × 6 pieces where sampling took 24
+    // points of the longest line.
+    constexpr int kSide = AreaGrid::kCells;
+    const glm::dvec3 cell = (sender.boxMax - sender.boxMin) / static_cast<double>(kSide);
+    const glm::dvec3 start = x + from * along;
+    glm::ivec3 at, step;
+    glm::dvec3 next, delta;
+    for (int a = 0; a < 3; ++a) {
+        at[a] = std::clamp(static_cast<int>(std::floor((start[a] - sender.boxMin[a]) / cell[a])), 0,
+                           kSide - 1);
+        step[a] = along[a] > 0.0 ? 1 : -1;
+        if (along[a] == 0.0) {
+            next[a] = delta[a] = std::numeric_limits<double>::infinity();
+            continue;
+        }
+        const double plane = sender.boxMin[a] + (at[a] + (along[a] > 0.0 ? 1 : 0)) * cell[a];
+        next[a] = (plane - x[a]) / along[a];
+        delta[a] = cell[a] / std::abs(along[a]);
+    }
+    const double perCell = static_cast<double>(AreaGrid::kCount) / volume;
     Emitters e;
-    for (int k = 0; k < kSteps; ++k) {
-        const double t = from + (k + 0.5) * step;
-        const int cell = AreaGrid::CellOf(x + t * along, sender.boxMin, sender.boxMax);
-        const double density =
-            static_cast<double>(sender.organArea->share[cell]) * kCellVolumes / volume;
-        e.integral += density * step;
-        e.distance += density * step * t;
+    for (double t = from; t < to;) {
+        const int a = next.x <= next.y ? (next.x <= next.z ? 0 : 2) : (next.y <= next.z ? 1 : 2);
+        const double exit = std::min(next[a], to);
+        if (exit > t) {
+            const int c = at.x + kSide * (at.y + kSide * at.z);
+            const double piece =
+                static_cast<double>(sender.organArea->share[c]) * perCell * (exit - t);
+            e.integral += piece;
+            e.distance += piece * 0.5 * (t + exit);
+        }
+        t = exit;
+        at[a] += step[a];
+        if (at[a] < 0 || at[a] >= kSide) break;
+        next[a] += delta[a];
     }
     if (e.integral > 0.0) e.distance /= e.integral;
     return e;
