@@ -23,21 +23,13 @@ double ChordShare(const glm::dvec3& x, const glm::dvec3& omega, const glm::dvec3
     return (span.exit - std::max(span.enter, 0.0)) / (span.exit - span.enter);
 }
 
-// Where the light a closed instance sends along a line leaves from, between distances
-// `from` and `to` along it: ∫ e dℓ, e the share of its light leaving per m³ (its organs'
-// area share per cell over the cell's volume; 1 / V without an AreaGrid), and the distance
-// that integral is centred on.
-struct Emitters {
-    double integral = 0.0;  // 1/m²
-    double distance = 0.0;  // m
-};
+}  // namespace
+
 Emitters EmittersAlong(const ClosedNode& sender, const glm::dvec3& x, const glm::dvec3& along,
                        double from, double to, double volume) {
     const double length = to - from;
     if (!sender.organArea) return {length / volume, from + 0.5 * length};
-    // The density is constant in each cell: the line walked cell by cell (Amanatides & Woo
-    // 1987), each piece taken whole. Exact, and at most 3 × 6 pieces where sampling took 24
-    // points of the longest line.
+    // The line walked cell by cell (Amanatides & Woo 1987), each piece taken whole.
     constexpr int kSide = AreaGrid::kCells;
     const glm::dvec3 cell = (sender.boxMax - sender.boxMin) / static_cast<double>(kSide);
     const glm::dvec3 start = x + from * along;
@@ -75,8 +67,6 @@ Emitters EmittersAlong(const ClosedNode& sender, const glm::dvec3& x, const glm:
     if (e.integral > 0.0) e.distance /= e.integral;
     return e;
 }
-
-}  // namespace
 
 bool BoundsOverlap(const HrcNode& a, const HrcNode& b) {
     return glm::length(b.centroid - a.centroid) < a.radius + b.radius;
