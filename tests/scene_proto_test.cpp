@@ -5,6 +5,7 @@
 #include <google/protobuf/util/message_differencer.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -167,6 +168,22 @@ struct BadFile {
     ErrorCode code;
     const char* field;
 };
+
+TEST(SceneFile, NamesTheLineOfAMistakeFarIntoALargeFile) {
+    // A text file is parsed as it is read, in blocks: a mistake megabytes in is still named
+    // by its own line and column.
+    std::string text = kHeader;
+    for (int i = 0; i < 40000; ++i)
+        text += "# a comment line of the large scene file, " + std::to_string(i) + "\n";
+    const auto line = std::count(text.begin(), text.end(), '\n') + 1;
+    text += "bands { nme: \"PAR\" }\n";
+    ASSERT_GT(text.size(), 1'000'000u);
+    const InputError e = ErrorOf(text);
+    EXPECT_EQ(e.Code(), ErrorCode::kParse) << e.what();
+    // path:line:column, the column the parser had reached in the line.
+    const std::string where = "bad.scene.txtpb:" + std::to_string(line) + ":";
+    EXPECT_NE(e.Field().find(where), std::string::npos) << e.what();
+}
 
 TEST(SceneFile, NamesTheFieldOfEveryMistake) {
     const std::string header = kHeader;
