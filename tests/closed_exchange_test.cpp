@@ -43,7 +43,8 @@ TEST(EmittersAlong, AnEvenGridGivesTheLengthOverTheVolume) {
     auto grid = std::make_shared<AreaGrid>();
     grid->share.fill(1.0f / AreaGrid::kCount);
     const ClosedNode box = Box(grid);
-    // Oblique, every component's sign, from outside the box and from inside it.
+    // Oblique, every component's sign, from outside the box and from inside it. The shares
+    // are floats: 1/216 to a relative 3e-8, the bound 1e-6.
     for (const glm::dvec3& omega : {glm::dvec3(0.3, 0.5, 0.8), glm::dvec3(-0.7, 0.2, -0.4),
                                     glm::dvec3(0.0, -1.0, 0.2), glm::dvec3(0.0, 0.0, 1.0)}) {
         const glm::dvec3 along = glm::normalize(omega);
@@ -62,7 +63,7 @@ TEST(EmittersAlong, OneCellsOrgansGiveItsChordTimesItsDensity) {
     // Every organ in the cell [2,3] × [3,4] × [1,2]; a line through it from a corner.
     auto grid = std::make_shared<AreaGrid>();
     const glm::ivec3 cell(2, 3, 1);
-    grid->share[cell.x + AreaGrid::kCells * (cell.y + AreaGrid::kCells * cell.z)] = 1.0f;
+    grid->share[AreaGrid::Index(cell.x, cell.y, cell.z)] = 1.0f;
     const ClosedNode box = Box(grid);
     const glm::dvec3 lo(cell), hi = lo + 1.0;
     for (const glm::dvec3& x : {glm::dvec3(0.1, 0.5, 0.2), glm::dvec3(5.9, 5.8, 4.7)}) {

@@ -53,7 +53,7 @@ Emitters EmittersAlong(const ClosedNode& sender, const glm::dvec3& x, const glm:
         const int a = next.x <= next.y ? (next.x <= next.z ? 0 : 2) : (next.y <= next.z ? 1 : 2);
         const double exit = std::min(next[a], to);
         if (exit > t) {
-            const int c = at.x + kSide * (at.y + kSide * at.z);
+            const int c = AreaGrid::Index(at.x, at.y, at.z);
             const double piece =
                 static_cast<double>(sender.organArea->share[c]) * perCell * (exit - t);
             e.integral += piece;

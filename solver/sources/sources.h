@@ -83,7 +83,7 @@ struct Emitter {
     // Held, pieces of a black lamp: its light is its exitance, even over each (NodeModel::Lamp).
     bool lamp = false;
     // Held: per triangle of the mesh, per band, what each sends (empty: exitanceWm2 all over).
-    std::vector<double> triangleExitanceWm2;
+    std::vector<double> triangleExitanceWm2{};
 
     // What triangle t of the mesh sends in band b (W/m²).
     double Exitance(std::size_t t, std::size_t b) const {

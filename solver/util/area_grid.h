@@ -23,8 +23,10 @@ struct AreaGrid {
         const auto axis = [&](int i) {
             return std::clamp(static_cast<int>(std::floor(at[i])), 0, kCells - 1);
         };
-        return axis(0) + kCells * (axis(1) + kCells * axis(2));
+        return Index(axis(0), axis(1), axis(2));
     }
+    // The cell (i, j, k), each 0..kCells - 1 along x, y, z.
+    static int Index(int i, int j, int k) { return i + kCells * (j + kCells * k); }
 };
 
 }  // namespace leaflux
