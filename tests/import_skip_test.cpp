@@ -9,6 +9,7 @@
 
 #include "server/scene_proto.h"
 #include "solver/io/importers.h"
+#include "solver/scene/world_frames.h"
 #include "solver/solve.h"
 #include "solver/util/error.h"
 

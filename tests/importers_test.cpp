@@ -8,6 +8,7 @@
 #include <set>
 
 #include "solver/scene/scene.h"
+#include "solver/scene/world_frames.h"
 #include "solver/util/error.h"
 
 namespace leaflux {

@@ -19,6 +19,7 @@
 #include "solver/instancing/instance_tree.h"
 #include "solver/results/accuracy.h"
 #include "solver/results/export.h"
+#include "solver/scene/world_frames.h"
 #include "solver/solve.h"
 #include "tests/scene_builders.h"
 

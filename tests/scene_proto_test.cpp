@@ -120,6 +120,52 @@ TEST(SceneFile, ReadsAndWritesTheBinaryEncodingByItsName) {
     }
 }
 
+// A binary file is read a node at a time: its nodes may come anywhere among the other
+// fields (a concatenation of messages is their merge), a file cut short is refused, and
+// the node limit holds before any node is converted.
+TEST(SceneFile, ReadsABinaryFileANodeAtATime) {
+    Scene scene;
+    scene.bands = {{"PAR"}};
+    scene.optics = {{"leaf", {{0.1, 0.1, 0.05, 0.05}}}, {"stem", {{0.1, 0.1, 0, 0}}}};
+    TreeParameters tree;
+    tree.leafCount = 30;
+    AddTree(scene, tree, {0, 0, 0});
+    scene.sources.suns.push_back({glm::dvec3(0.0, 0.0, 1.0), {400.0}, 0.0});
+    const v1::Scene whole = ToProto(scene);
+    // Nodes first, then the bands and optics with more nodes, then the rest.
+    v1::Scene first, second, third = whole;
+    third.clear_nodes();
+    third.clear_bands();
+    third.clear_optics();
+    *second.mutable_bands() = whole.bands();
+    *second.mutable_optics() = whole.optics();
+    for (int i = 0; i < whole.nodes_size(); ++i)
+        *(i < 10 ? first : i < 40 ? second : third).add_nodes() = whole.nodes(i);
+    const std::string bytes =
+        first.SerializeAsString() + second.SerializeAsString() + third.SerializeAsString();
+    const std::string path = Write("interleaved.scene.binpb", bytes);
+    EXPECT_TRUE(
+        google::protobuf::util::MessageDifferencer::Equals(ToProto(LoadSceneFile(path)), whole));
+
+    SceneLimits limits;
+    limits.maxNodes = static_cast<std::size_t>(whole.nodes_size()) - 1;
+    try {
+        LoadSceneFile(path, {}, limits);
+        ADD_FAILURE() << "a file over the node limit was accepted";
+    } catch (const TooLarge& error) {
+        EXPECT_EQ(error.Field(), "nodes");
+    }
+
+    const std::string cut = Write("cut.scene.binpb", bytes.substr(0, bytes.size() / 2));
+    try {
+        LoadSceneFile(cut);
+        ADD_FAILURE() << "a file cut short was accepted";
+    } catch (const InputError& error) {
+        EXPECT_EQ(error.Code(), ErrorCode::kParse);
+        EXPECT_EQ(error.Field(), cut);
+    }
+}
+
 TEST(SceneFile, ImportsCaribuWithItsOptics) {
     const std::string data = LEAFLUX_SHARED_DATA;
     const Scene scene = LoadSceneFile(Write(

@@ -14,6 +14,7 @@
 #include "server/scene_proto.h"
 #include "solver/generate/generator.h"
 #include "solver/scene/geometry.h"
+#include "solver/scene/world_frames.h"
 #include "solver/util/error.h"
 
 namespace leaflux {

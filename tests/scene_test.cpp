@@ -11,6 +11,7 @@
 #include "solver/generate/generator.h"
 #include "solver/scene/geometry.h"
 #include "solver/scene/scene_store.h"
+#include "solver/scene/world_frames.h"
 #include "solver/util/error.h"
 #include "tests/scene_builders.h"
 

@@ -60,7 +60,17 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
     // Boxes, areas and where the areas lie over each instance's whole subtree, in its own
     // frame: the box first, then each triangle's area into its cell (two walks, so that
     // nothing the size of the subtree is kept).
-    const auto worldFromLocal = WorldFromLocal(scene);
+    // A part root's frame in the world, up its parents (the frames of every node would be
+    // 136 bytes each).
+    const auto worldFromRoot = [&](std::size_t i) {
+        glm::dmat4 frame = scene.nodes[i].parentFromLocal;
+        for (NodeId up = scene.nodes[i].parent; up != kNoParent;) {
+            const Node& parent = scene.nodes[indexOf.at(up)];
+            frame = parent.parentFromLocal * frame;
+            up = parent.parent;
+        }
+        return frame;
+    };
     const auto walkOrgans = [&](const Part& part, const auto& visit) {
         std::vector<std::pair<std::size_t, glm::dmat4>> walk{{part.rootIndex, glm::dmat4(1.0)}};
         while (!walk.empty()) {
@@ -86,7 +96,7 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
         const double pad = std::max(kMinPadM, kPadFraction * glm::length(hi - lo));
         part.boxMin = lo - pad;
         part.boxMax = hi + pad;
-        const glm::dmat4 worldFromInstance = worldFromLocal.at(part.root);
+        const glm::dmat4 worldFromInstance = worldFromRoot(part.rootIndex);
         cells.fill(0.0);
         walkOrgans(part, [&](const Mesh& mesh, const glm::dmat4& instanceFromNode) {
             const glm::dmat4 worldFromNode = worldFromInstance * instanceFromNode;

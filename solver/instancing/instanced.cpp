@@ -18,6 +18,7 @@
 #include "solver/instancing/signature.h"
 #include "solver/raytrace/occlusion.h"
 #include "solver/scene/geometry.h"
+#include "solver/scene/world_frames.h"
 #include "solver/util/box.h"
 #include "solver/util/check.h"
 #include "solver/util/cores.h"
@@ -77,12 +78,7 @@ class InstancedSolve {
                 firstOther_ = r;
             }
         }
-        const auto worldFromLocal = WorldFromLocal(scene);
-        for (const Node& node : scene.nodes) {
-            if (!node.organ) continue;
-            for (const Triangle& t : PlaceMesh(*node.organ->mesh, worldFromLocal.at(node.id)))
-                organAreaNormals_.push_back(glm::vec3(t.areaM2 * t.normal));
-        }
+        organAreaNormals_ = OrganAreaNormals(scene, organTriangles_);
         out_.solution.light.assign(receivers.receivers.size(),
                                    std::vector<BandLight>(scene.bands.size()));
         out_.solution.balance.assign(scene.bands.size(), EnergyBalance{});
@@ -108,6 +104,21 @@ class InstancedSolve {
 
   private:
     static constexpr std::uint32_t kNoReceiver = 0xFFFFFFFFu;
+
+    // Every organ triangle's area times its normal, in the world. The nodes' frames are
+    // freed before the solve's own memory is taken: beside the organs' light they made
+    // the peak of a plantation's solve.
+    static std::vector<glm::vec3> OrganAreaNormals(const Scene& scene, std::size_t triangles) {
+        std::vector<glm::vec3> areaNormals;
+        areaNormals.reserve(triangles);
+        const WorldFrames worldFromLocal(scene);
+        for (const Node& node : scene.nodes) {
+            if (!node.organ) continue;
+            for (const Triangle& t : PlaceMesh(*node.organ->mesh, worldFromLocal.at(node.id)))
+                areaNormals.push_back(glm::vec3(t.areaM2 * t.normal));
+        }
+        return areaNormals;
+    }
 
     // Direct light alone: an opened instance takes the suns, sky and lamps alone, not what
     // the levels it lies in scattered (held, or per bin).

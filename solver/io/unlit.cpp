@@ -6,6 +6,7 @@
 #include <cmath>
 #include <set>
 
+#include "solver/scene/world_frames.h"
 #include "solver/util/error.h"
 
 namespace leaflux {

@@ -2,6 +2,8 @@
 
 #include <limits>
 
+#include "solver/scene/world_frames.h"
+
 namespace leaflux {
 namespace {
 // Flatten's receivers as their triangles are added: each one's area and triangle range, the

@@ -9,6 +9,7 @@
 #include <unordered_set>
 
 #include "solver/scene/light_units.h"
+#include "solver/scene/world_frames.h"
 #include "solver/util/error.h"
 
 namespace leaflux {
@@ -349,30 +350,6 @@ Scene WithBands(const Scene& scene, const std::vector<int>& bands) {
     for (Emitter& emitter : subset.sources.emitters)
         emitter.exitanceWm2 = pick(emitter.exitanceWm2);
     return subset;
-}
-
-std::unordered_map<NodeId, glm::dmat4> WorldFromLocal(const Scene& scene) {
-    std::unordered_map<NodeId, const Node*> byId;
-    byId.reserve(scene.nodes.size());
-    for (const Node& node : scene.nodes) byId.emplace(node.id, &node);
-    std::unordered_map<NodeId, glm::dmat4> result;
-    result.reserve(scene.nodes.size());
-    for (const Node& node : scene.nodes) {
-        // Collect the unresolved ancestors, then compose downwards.
-        std::vector<const Node*> chain;
-        for (const Node* at = &node; at && !result.count(at->id);
-             at = at->parent == kNoParent ? nullptr : byId.at(at->parent)) {
-            chain.push_back(at);
-            if (chain.size() > scene.nodes.size()) return result;  // a cycle: Validate reports it
-        }
-        for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
-            const Node* at = *it;
-            const glm::dmat4 worldFromParent =
-                at->parent == kNoParent ? glm::dmat4(1.0) : result.at(at->parent);
-            result[at->id] = worldFromParent * at->parentFromLocal;
-        }
-    }
-    return result;
 }
 
 double TriangleArea(const glm::dmat4& worldFromLocal, const Mesh& mesh, const glm::uvec3& tri) {

@@ -135,9 +135,6 @@ void ValidateSun(const Scene& scene, const Sun& sun, const std::string& field);
 // emitters keep only those bands' values. A solver then does no work for the others.
 Scene WithBands(const Scene& scene, const std::vector<int>& bands);
 
-// worldFromLocal of every node, by id. Requires a validated scene (no cycles).
-std::unordered_map<NodeId, glm::dmat4> WorldFromLocal(const Scene& scene);
-
 // Area (m²) of a triangle mesh after applying worldFromLocal.
 double MeshArea(const Mesh& mesh, const glm::dmat4& worldFromLocal);
 // The area of one of the mesh's triangles, in the frame worldFromLocal takes it to.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "solver/scene/world_frames.h"
 #include "solver/util/check.h"
 #include "solver/util/error.h"
 

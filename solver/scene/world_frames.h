@@ -1,0 +1,36 @@
+// Where every node of a scene is in the world: worldFromLocal, the product of the
+// parentFromLocal frames from its root down.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <vector>
+
+#include "solver/scene/scene.h"
+
+namespace leaflux {
+
+// The frames are kept in the order of the nodes' ids, found by binary search: 136 bytes a
+// node, made without an allocation per node. A hash map of frames by id, built with a
+// second map of the nodes by id, took about 200 bytes a node at its peak (the 543,000 nodes
+// of a plantation of 233 trees: 113 MB, one of the largest things an instanced solve
+// held).
+class WorldFrames {
+  public:
+    // A node whose parent links loop, or lead to an id no node has, gets no frame
+    // (Scene::Validate reports both).
+    explicit WorldFrames(const Scene& scene);
+
+    // The frame of the node with this id; throws std::out_of_range when it has none.
+    glm::dmat4 at(NodeId id) const;
+    std::size_t size() const { return ids_.size(); }
+
+  private:
+    std::vector<NodeId> ids_;  // rising
+    std::vector<glm::dmat4> frames_;
+};
+
+// worldFromLocal of every node, by id. Requires a validated scene (no cycles).
+inline WorldFrames WorldFromLocal(const Scene& scene) { return WorldFrames(scene); }
+
+}  // namespace leaflux

@@ -1,0 +1,84 @@
+// WorldFrames: every node's frame in the world is the product of its ancestors' frames,
+// whatever the order of the nodes and their ids; nodes whose parent links loop or lead
+// nowhere have none.
+#include "solver/scene/world_frames.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <glm/gtc/matrix_transform.hpp>
+#include <stdexcept>
+
+#include "solver/generate/generator.h"
+
+namespace leaflux {
+namespace {
+
+Node At(NodeId id, NodeId parent, const glm::dmat4& parentFromLocal) {
+    Node node;
+    node.id = id;
+    node.parent = parent;
+    node.parentFromLocal = parentFromLocal;
+    return node;
+}
+
+// The frame by walking up from the node, one parent at a time.
+glm::dmat4 ByWalkingUp(const Scene& scene, NodeId id) {
+    glm::dmat4 frame(1.0);
+    while (id != kNoParent) {
+        const Node& node = *std::find_if(scene.nodes.begin(), scene.nodes.end(),
+                                         [&](const Node& n) { return n.id == id; });
+        frame = node.parentFromLocal * frame;
+        id = node.parent;
+    }
+    return frame;
+}
+
+TEST(WorldFrames, AreTheProductsOfTheAncestorsFramesInAnyOrder) {
+    const glm::dmat4 lift = glm::translate(glm::dmat4(1.0), {0.0, 0.0, 1.0});
+    const glm::dmat4 turn = glm::rotate(glm::dmat4(1.0), 0.3, glm::dvec3(1.0, 0.0, 0.0));
+    const glm::dmat4 grow = glm::scale(glm::dmat4(1.0), glm::dvec3(2.0));
+    Scene scene;
+    // Children before their parents, ids falling and rising.
+    scene.nodes = {At(7, 40, grow), At(40, 3, turn), At(3, kNoParent, lift), At(9, 3, grow)};
+    const WorldFrames frames(scene);
+    EXPECT_EQ(frames.size(), 4u);
+    for (const Node& node : scene.nodes) {
+        const glm::dmat4 expected = ByWalkingUp(scene, node.id), got = frames.at(node.id);
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) EXPECT_DOUBLE_EQ(got[c][r], expected[c][r]) << node.id;
+    }
+    EXPECT_THROW(frames.at(8), std::out_of_range);
+}
+
+TEST(WorldFrames, OfAGeneratedTreeAreItsNodesWalkedUp) {
+    Scene scene;
+    TreeParameters tree;
+    tree.leafCount = 60;
+    AddTree(scene, tree, {1.0, 2.0, 0.0});
+    std::reverse(scene.nodes.begin(), scene.nodes.end());  // ids falling
+    const WorldFrames frames(scene);
+    ASSERT_EQ(frames.size(), scene.nodes.size());
+    for (const Node& node : scene.nodes) {
+        const glm::dmat4 expected = ByWalkingUp(scene, node.id), got = frames.at(node.id);
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) EXPECT_NEAR(got[c][r], expected[c][r], 1e-12) << node.id;
+    }
+}
+
+TEST(WorldFrames, NodesWhoseParentLinksLoopOrLeadNowhereHaveNone) {
+    const glm::dmat4 one(1.0);
+    Scene scene;
+    scene.nodes = {At(1, kNoParent, one), At(2, 1, one),                 // a root and its child
+                   At(3, 4, one),         At(4, 5, one), At(5, 3, one),  // a loop
+                   At(6, 4, one),                                        // under the loop
+                   At(7, 99, one),        At(8, 7, one)};                // under a missing parent
+    const WorldFrames frames(scene);
+    EXPECT_EQ(frames.size(), 2u);
+    EXPECT_NO_THROW(frames.at(1));
+    EXPECT_NO_THROW(frames.at(2));
+    for (NodeId id : {3, 4, 5, 6, 7, 8}) EXPECT_THROW(frames.at(id), std::out_of_range) << id;
+}
+
+}  // namespace
+}  // namespace leaflux
