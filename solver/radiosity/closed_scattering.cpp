@@ -32,7 +32,12 @@ ClosedResponse::ClosedResponse(const NodeModel& model,
     const Hierarchy& hierarchy = model.Nodes();
     const DirectionSet& directions = model.Directions();
     const std::size_t closedCount = hierarchy.Closed().size();
-    values_.assign(closedCount * bands_ * bins_ * inputs_, 0.0);
+    slot_.assign(closedCount, kHeld);
+    std::size_t scattering = 0;
+    for (std::size_t c = 0; c < closedCount; ++c) {
+        if (!hierarchy.Closed()[c].Held()) slot_[c] = scattering++;
+    }
+    values_.assign(scattering * bands_ * bins_ * inputs_, 0.0);
     tbb::parallel_for(std::size_t{0}, closedCount, [&](std::size_t c) {
         const ClosedNode& closed = hierarchy.Closed()[c];
         if (closed.Held()) return;  // it sends what it was given
@@ -43,7 +48,7 @@ ClosedResponse::ClosedResponse(const NodeModel& model,
             in[bins_ + s] = closed.ToInstance(sources[s].toward);
         for (std::size_t b = 0; b < bands_; ++b) {
             closed.contents->PhaseTable(static_cast<int>(b), in, out,
-                                        values_.data() + (c * bands_ + b) * bins_ * inputs_);
+                                        values_.data() + (slot_[c] * bands_ + b) * bins_ * inputs_);
         }
     });
 }
