@@ -1,12 +1,13 @@
-// WorldFrames: every node's frame in the world is the product of its ancestors' frames,
-// whatever the order of the nodes and their ids; nodes whose parent links loop or lead
-// nowhere have none.
+// WorldFrames and ForEachWorldFrame: every node's frame in the world is the product of its
+// ancestors' frames, whatever the order of the nodes and their ids; nodes whose parent
+// links loop or lead nowhere have none.
 #include "solver/scene/world_frames.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <glm/gtc/matrix_transform.hpp>
+#include <set>
 #include <stdexcept>
 
 #include "solver/generate/generator.h"
@@ -64,6 +65,26 @@ TEST(WorldFrames, OfAGeneratedTreeAreItsNodesWalkedUp) {
         for (int c = 0; c < 4; ++c)
             for (int r = 0; r < 4; ++r) EXPECT_NEAR(got[c][r], expected[c][r], 1e-12) << node.id;
     }
+}
+
+TEST(WorldFrames, AWalkVisitsEachNodeOnceAfterItsParentWithItsFrame) {
+    Scene scene;
+    TreeParameters tree;
+    tree.leafCount = 60;
+    AddTree(scene, tree, {1.0, 2.0, 0.0});
+    std::reverse(scene.nodes.begin(), scene.nodes.end());      // children before their parents
+    scene.nodes.push_back(At(90001, 90002, glm::dmat4(1.0)));  // under a missing parent
+    const WorldFrames frames(scene);
+    std::set<NodeId> visited;
+    ForEachWorldFrame(scene, [&](const Node& node, const glm::dmat4& frame) {
+        EXPECT_TRUE(node.parent == kNoParent || visited.count(node.parent)) << node.id;
+        EXPECT_TRUE(visited.insert(node.id).second) << node.id;
+        const glm::dmat4 expected = frames.at(node.id);
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) EXPECT_NEAR(frame[c][r], expected[c][r], 1e-12) << node.id;
+    });
+    EXPECT_EQ(visited.size(), scene.nodes.size() - 1);
+    EXPECT_FALSE(visited.count(90001));
 }
 
 TEST(WorldFrames, NodesWhoseParentLinksLoopOrLeadNowhereHaveNone) {
