@@ -35,6 +35,20 @@ glm::dmat4 ByWalkingUp(const Scene& scene, NodeId id) {
     return frame;
 }
 
+// Every element within `tolerance` (0: the same to the last bit but rounding, as
+// EXPECT_DOUBLE_EQ takes it).
+void ExpectFrame(const glm::dmat4& got, const glm::dmat4& expected, double tolerance, NodeId id) {
+    for (int c = 0; c < 4; ++c) {
+        for (int r = 0; r < 4; ++r) {
+            if (tolerance == 0.0) {
+                EXPECT_DOUBLE_EQ(got[c][r], expected[c][r]) << "node " << id;
+            } else {
+                EXPECT_NEAR(got[c][r], expected[c][r], tolerance) << "node " << id;
+            }
+        }
+    }
+}
+
 TEST(WorldFrames, AreTheProductsOfTheAncestorsFramesInAnyOrder) {
     const glm::dmat4 lift = glm::translate(glm::dmat4(1.0), {0.0, 0.0, 1.0});
     const glm::dmat4 turn = glm::rotate(glm::dmat4(1.0), 0.3, glm::dvec3(1.0, 0.0, 0.0));
@@ -46,8 +60,7 @@ TEST(WorldFrames, AreTheProductsOfTheAncestorsFramesInAnyOrder) {
     EXPECT_EQ(frames.size(), 4u);
     for (const Node& node : scene.nodes) {
         const glm::dmat4 expected = ByWalkingUp(scene, node.id), got = frames.at(node.id);
-        for (int c = 0; c < 4; ++c)
-            for (int r = 0; r < 4; ++r) EXPECT_DOUBLE_EQ(got[c][r], expected[c][r]) << node.id;
+        ExpectFrame(got, expected, 0.0, node.id);
     }
     EXPECT_THROW(frames.at(8), std::out_of_range);
 }
@@ -62,8 +75,7 @@ TEST(WorldFrames, OfAGeneratedTreeAreItsNodesWalkedUp) {
     ASSERT_EQ(frames.size(), scene.nodes.size());
     for (const Node& node : scene.nodes) {
         const glm::dmat4 expected = ByWalkingUp(scene, node.id), got = frames.at(node.id);
-        for (int c = 0; c < 4; ++c)
-            for (int r = 0; r < 4; ++r) EXPECT_NEAR(got[c][r], expected[c][r], 1e-12) << node.id;
+        ExpectFrame(got, expected, 1e-12, node.id);
     }
 }
 
@@ -79,9 +91,7 @@ TEST(WorldFrames, AWalkVisitsEachNodeOnceAfterItsParentWithItsFrame) {
     ForEachWorldFrame(scene, [&](const Node& node, const glm::dmat4& frame) {
         EXPECT_TRUE(node.parent == kNoParent || visited.count(node.parent)) << node.id;
         EXPECT_TRUE(visited.insert(node.id).second) << node.id;
-        const glm::dmat4 expected = frames.at(node.id);
-        for (int c = 0; c < 4; ++c)
-            for (int r = 0; r < 4; ++r) EXPECT_NEAR(frame[c][r], expected[c][r], 1e-12) << node.id;
+        ExpectFrame(frame, frames.at(node.id), 1e-12, node.id);
     });
     EXPECT_EQ(visited.size(), scene.nodes.size() - 1);
     EXPECT_FALSE(visited.count(90001));
