@@ -604,12 +604,32 @@ Scene LoadSceneFile(const std::string& path, const ImportOptions& options,
         const v1::Scene message = BinaryWithoutNodes(path, nodes);
         scene = UncheckedFromProto(message, nodes, base, limits, options);
     } else {
+        // So too from text, where each node starts a line and its closing brace ends one
+        // (as leaflux writes them): the rest first, then the nodes a run at a time
+        // (SplitTextFile). The 233-tree plantation's 240 MB were read into 543 MiB at the
+        // peak, 221 once loaded; now 186 once loaded, and the solve makes the peak.
+        const auto fail = [](const TextFormatError& error) {
+            Fail(error.unreadable ? ErrorCode::kIo : ErrorCode::kParse, error.where,
+                 error.unreadable ? "cannot open the scene file" : error.what);
+        };
+        SplitTextFile file(path, "nodes");
         v1::Scene message;
-        if (const auto error = ReadTextFormat(path, message)) {
-            Fail(error->unreadable ? ErrorCode::kIo : ErrorCode::kParse, error->where,
-                 error->unreadable ? "cannot open the scene file" : error->what);
+        std::size_t taken = 0;
+        if (const auto error = file.ReadRest(message, taken)) fail(*error);
+        if (message.nodes_size() > 0) {  // nodes laid out otherwise: the file read whole
+            message.Clear();
+            if (const auto error = ReadTextFormat(path, message)) fail(*error);
+            scene = UncheckedFromProto(message, NodesOf(message), base, limits, options);
+        } else {
+            const NodeSource nodes{taken, [&](const auto& visit) {
+                                       v1::Scene run;
+                                       const auto error = file.ForEachRun(run, [&] {
+                                           for (const v1::Node& node : run.nodes()) visit(node);
+                                       });
+                                       if (error) fail(*error);
+                                   }};
+            scene = UncheckedFromProto(message, nodes, base, limits, options);
         }
-        scene = UncheckedFromProto(message, NodesOf(message), base, limits, options);
     }
     // Checked once the file's message is freed: the check's tables of every node's frame
     // and name, beside the message and the scene, made the reading's peak (627 MiB for a
