@@ -6,7 +6,6 @@
 
 #include <cctype>
 #include <fstream>
-#include <vector>
 
 namespace leaflux {
 namespace {
@@ -38,13 +37,14 @@ std::optional<TextFormatError> Located(const std::string& path, const FirstError
         error->message};
 }
 
-// Merges `text`, which starts on line `firstLine` (0-based) of the file `path`, into message.
+// Parses `text`, which starts on line `firstLine` (0-based) of the file `path`, into message
+// (as a whole file is: a field that is not repeated may be given once).
 std::optional<TextFormatError> ParseLines(const std::string& path, const std::string& text,
                                           int firstLine, google::protobuf::Message& message) {
     google::protobuf::TextFormat::Parser parser;
     FirstError errors(firstLine);
     parser.RecordErrorsTo(&errors);
-    if (parser.MergeFromString(text, &message)) return std::nullopt;
+    if (parser.ParseFromString(text, &message)) return std::nullopt;
     return Located(path, errors);
 }
 
@@ -175,7 +175,6 @@ std::optional<TextFormatError> SplitTextFile::ForEachRun(google::protobuf::Messa
     const auto flush = [&] {
         if (complete == 0 || error) return;
         text.resize(complete);
-        run.Clear();
         error = ParseLines(path_, text, first, run);
         if (!error) onRun();
         text.clear();

@@ -33,7 +33,7 @@ class SplitTextFile {
     // keeps its line and column) into `rest`, and how many were taken apart.
     std::optional<TextFormatError> ReadRest(google::protobuf::Message& rest, std::size_t& taken);
     // The fields taken apart, in order, runs of them at a time: each run parsed into `run`
-    // (cleared first), then onRun().
+    // (what it held before cleared), then onRun().
     std::optional<TextFormatError> ForEachRun(google::protobuf::Message& run,
                                               const std::function<void()>& onRun);
 

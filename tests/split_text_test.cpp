@@ -90,6 +90,7 @@ TEST(SplitTextFile, NamesAMistakeWhereTheWholeFilesParseDoes) {
     for (const auto& [what, mistake] :
          {std::pair{"in a node", "nodes {\n  id: 3001\n  nme: \"x\"\n}\n"},
           {"in the rest", "sky { discretisation: 3 }\n"},
+         {"a field given twice", "nodes {\n  id: 3001\n  id: 3002\n}\n"},
           {"an unclosed node", "nodes {\n  id: 3001\n"}}) {
         const std::string path = Write("mistake.scene.txtpb", many + mistake + many);
         v1::Scene whole;
