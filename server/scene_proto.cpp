@@ -597,9 +597,10 @@ Scene LoadSceneFile(const std::string& path, const ImportOptions& options,
     Scene scene;
     const std::string base = std::filesystem::path(path).parent_path().string();
     if (IsBinarySceneFile(path)) {
-        // The nodes, most of a large scene, a node at a time (BinaryNodes): the whole
+        // The nodes, most of a large scene, a node at a time (BinaryWithoutNodes): the whole
         // message beside the scene it becomes made the reading's peak (445 MB of heap for a
-        // plantation of 233 trees from 81 MB of binary, 209 MB now).
+        // plantation of 233 trees from 81 MB of binary, 264 MB of it the message); now the
+        // solve makes the peak.
         NodeSource nodes;
         const v1::Scene message = BinaryWithoutNodes(path, nodes);
         scene = UncheckedFromProto(message, nodes, base, limits, options);
