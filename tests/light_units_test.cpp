@@ -16,15 +16,10 @@
 #include "solver/solve.h"
 #include "solver/util/error.h"
 #include "tests/scene_builders.h"
+#include "tests/temp_file.h"
 
 namespace leaflux {
 namespace {
-
-std::string Write(const std::string& name, const std::string& text) {
-    const std::string path = ::testing::TempDir() + name;
-    std::ofstream(path) << text;
-    return path;
-}
 
 // The log lines of `run`, at warning level and above.
 template <typename F>
@@ -76,8 +71,8 @@ TEST(PhotonUnits, APARBandHasTheDaylightFactorUnlessItGivesItsOwn) {
 TEST(PhotonUnits, AScenesFactorRoundTripsAndABadOneIsRefusedByField) {
     const std::string bands =
         R"(bands { name: "PAR" } bands { name: "NIR" photon_umol_per_j: 9.5 })";
-    const Scene scene =
-        LoadSceneFile(Write("photons.scene.txtpb", PlateScene(bands, Sun(400, 300))));
+    const Scene scene = LoadSceneFile(
+        testing::WriteTempFile("photons.scene.txtpb", PlateScene(bands, Sun(400, 300))));
     EXPECT_EQ(scene.bands[0].photonUmolPerJ, 0.0);  // as given: the default is PhotonUmolPerJ's
     EXPECT_EQ(scene.bands[1].photonUmolPerJ, 9.5);
     const std::string path = ::testing::TempDir() + "photons_again.scene.txtpb";
@@ -90,7 +85,7 @@ TEST(PhotonUnits, AScenesFactorRoundTripsAndABadOneIsRefusedByField) {
                            R"( } bands { name: "NIR" })",
                        Sun(400, 300));
         try {
-            LoadSceneFile(Write("bad_photons.scene.txtpb", text));
+            LoadSceneFile(testing::WriteTempFile("bad_photons.scene.txtpb", text));
             ADD_FAILURE() << "accepted photon_umol_per_j: " << bad;
         } catch (const InputError& e) {
             EXPECT_EQ(e.Field(), "bands[PAR].photon_umol_per_j") << bad;
@@ -122,8 +117,8 @@ std::map<std::string, std::map<std::string, std::string>> Rows(const std::string
 }
 
 TEST(PhotonUnits, CsvColumnsGivePARInMicromolesBesideWatts) {
-    const Scene scene =
-        LoadSceneFile(Write("csv_photons.scene.txtpb", PlateScene(kTwoBands, Sun(400, 300))));
+    const Scene scene = LoadSceneFile(
+        testing::WriteTempFile("csv_photons.scene.txtpb", PlateScene(kTwoBands, Sun(400, 300))));
     const PreparedScene prepared(scene);
     SolverSettings settings;
     settings.kind = SolverKind::kHrc;
@@ -156,7 +151,8 @@ TEST(PhotonUnits, CsvColumnsGivePARInMicromolesBesideWatts) {
 
 TEST(SourceWarnings, ASunInMicromolesGivenAsWattsIsWarnedOf) {
     const std::string log = LogOf([] {
-        LoadSceneFile(Write("umol_sun.scene.txtpb", PlateScene(kTwoBands, Sun(2000, 300))));
+        LoadSceneFile(
+            testing::WriteTempFile("umol_sun.scene.txtpb", PlateScene(kTwoBands, Sun(2000, 300))));
     });
     EXPECT_NE(log.find("suns[0].normal_irradiance[PAR] is 2000 W/m²"), std::string::npos) << log;
     EXPECT_NE(log.find("µmol m⁻² s⁻¹"), std::string::npos) << log;
@@ -166,7 +162,8 @@ TEST(SourceWarnings, ASunInMicromolesGivenAsWattsIsWarnedOf) {
 
 TEST(SourceWarnings, PlausibleSourcesAreNotWarnedOf) {
     const std::string log = LogOf([] {
-        LoadSceneFile(Write("plausible.scene.txtpb", PlateScene(kTwoBands, Sun(450, 400) + R"(
+        LoadSceneFile(testing::WriteTempFile("plausible.scene.txtpb",
+                                             PlateScene(kTwoBands, Sun(450, 400) + R"(
 sky { horizontal_irradiance { key: "PAR" value: 200 } horizontal_irradiance { key: "NIR" value: 150 } }
 )")));
     });
@@ -175,11 +172,13 @@ sky { horizontal_irradiance { key: "PAR" value: 200 } horizontal_irradiance { ke
 
 TEST(SourceWarnings, OtherBandsAreWarnedOfAboveTheSolarConstantOnly) {
     const std::string log = LogOf([] {
-        LoadSceneFile(Write("nir_high.scene.txtpb", PlateScene(kTwoBands, Sun(400, 1400))));
+        LoadSceneFile(
+            testing::WriteTempFile("nir_high.scene.txtpb", PlateScene(kTwoBands, Sun(400, 1400))));
     });
     EXPECT_EQ(log, "");  // within the whole spectrum's 1361 W/m² (and 10 %)
     const std::string high = LogOf([] {
-        LoadSceneFile(Write("nir_higher.scene.txtpb", PlateScene(kTwoBands, Sun(400, 2000))));
+        LoadSceneFile(testing::WriteTempFile("nir_higher.scene.txtpb",
+                                             PlateScene(kTwoBands, Sun(400, 2000))));
     });
     EXPECT_NE(high.find("suns[0].normal_irradiance[NIR] is 2000 W/m²"), std::string::npos) << high;
     EXPECT_EQ(high.find("µmol"), std::string::npos) << high;  // NIR has no photon unit here
@@ -187,7 +186,7 @@ TEST(SourceWarnings, OtherBandsAreWarnedOfAboveTheSolarConstantOnly) {
 
 TEST(SourceWarnings, ASkyAndASunPeriodInMicromolesAreWarnedOf) {
     const std::string log = LogOf([] {
-        LoadSceneFile(Write("umol_sky.scene.txtpb", PlateScene(kTwoBands, R"(
+        LoadSceneFile(testing::WriteTempFile("umol_sky.scene.txtpb", PlateScene(kTwoBands, R"(
 sky { horizontal_irradiance { key: "PAR" value: 900 } horizontal_irradiance { key: "NIR" value: 150 } }
 sun_periods { latitude_deg: 45 day_of_year: 172 start_h: 8 end_h: 16 step_h: 1
               normal_irradiance { key: "PAR" value: 1800 } normal_irradiance { key: "NIR" value: 400 } }
@@ -200,29 +199,32 @@ sun_periods { latitude_deg: 45 day_of_year: 172 start_h: 8 end_h: 16 step_h: 1
 
 TEST(SourceWarnings, ASunBelowTheHorizonIsWarnedOf) {
     const std::string byDirection = LogOf([] {
-        LoadSceneFile(Write("sun_below.scene.txtpb",
-                            PlateScene(kTwoBands, Sun(400, 300, "direction { x: 1 z: -0.2 }"))));
+        LoadSceneFile(testing::WriteTempFile(
+            "sun_below.scene.txtpb",
+            PlateScene(kTwoBands, Sun(400, 300, "direction { x: 1 z: -0.2 }"))));
     });
     EXPECT_NE(byDirection.find("suns[0] is 11.3° below the horizon"), std::string::npos)
         << byDirection;
     const std::string atNight = LogOf([] {
-        LoadSceneFile(Write("sun_night.scene.txtpb",
-                            PlateScene(kTwoBands, Sun(400, 300,
-                                                      "solar { latitude_deg: 45 "
-                                                      "day_of_year: 172 solar_time_h: 1 }"))));
+        LoadSceneFile(testing::WriteTempFile(
+            "sun_night.scene.txtpb",
+            PlateScene(kTwoBands, Sun(400, 300,
+                                      "solar { latitude_deg: 45 "
+                                      "day_of_year: 172 solar_time_h: 1 }"))));
     });
     EXPECT_NE(atNight.find("suns[0] is "), std::string::npos) << atNight;
     EXPECT_NE(atNight.find("below the horizon"), std::string::npos) << atNight;
     const std::string low = LogOf([] {
-        LoadSceneFile(Write("sun_low.scene.txtpb",
-                            PlateScene(kTwoBands, Sun(400, 300, "direction { x: 1 z: 0.01 }"))));
+        LoadSceneFile(testing::WriteTempFile(
+            "sun_low.scene.txtpb",
+            PlateScene(kTwoBands, Sun(400, 300, "direction { x: 1 z: 0.01 }"))));
     });
     EXPECT_EQ(low, "");  // just above: meant
 }
 
 TEST(SourceWarnings, ACyclesSunIsWarnedOfAsTheDaemonReadsIt) {
-    const Scene scene =
-        LoadSceneFile(Write("cycle_sun.scene.txtpb", PlateScene(kTwoBands, Sun(400, 300))));
+    const Scene scene = LoadSceneFile(
+        testing::WriteTempFile("cycle_sun.scene.txtpb", PlateScene(kTwoBands, Sun(400, 300))));
     v1::Sun sun;
     sun.mutable_direction()->set_z(-1.0);
     (*sun.mutable_normal_irradiance())["PAR"] = 1500.0;

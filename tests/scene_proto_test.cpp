@@ -13,15 +13,10 @@
 
 #include "solver/generate/generator.h"
 #include "solver/util/error.h"
+#include "tests/temp_file.h"
 
 namespace leaflux {
 namespace {
-
-std::string Write(const std::string& name, const std::string& text) {
-    const std::string path = ::testing::TempDir() + name;
-    std::ofstream(path) << text;
-    return path;
-}
 
 const char* kHeader = R"(
 bands { name: "PAR" }
@@ -36,7 +31,7 @@ suns { solar { latitude_deg: 45 day_of_year: 172 solar_time_h: 12 } normal_irrad
 
 InputError ErrorOf(const std::string& text) {
     try {
-        LoadSceneFile(Write("bad.scene.txtpb", text));
+        LoadSceneFile(testing::WriteTempFile("bad.scene.txtpb", text));
     } catch (const InputError& e) {
         return e;
     }
@@ -45,7 +40,8 @@ InputError ErrorOf(const std::string& text) {
 }
 
 TEST(SceneFile, LoadsAPlateUnderASolarPositionSun) {
-    const Scene scene = LoadSceneFile(Write("plate.scene.txtpb", std::string(kHeader) + kPlate));
+    const Scene scene =
+        LoadSceneFile(testing::WriteTempFile("plate.scene.txtpb", std::string(kHeader) + kPlate));
     ASSERT_EQ(scene.nodes.size(), 1u);
     ASSERT_EQ(scene.sources.suns.size(), 1u);
     EXPECT_NEAR(glm::degrees(std::asin(scene.sources.suns[0].towardSun.z)), 68.44, 0.2);
@@ -104,7 +100,8 @@ TEST(SceneFile, ReadsAndWritesTheBinaryEncodingByItsName) {
     EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(fromText, fromBinary));
     EXPECT_EQ(fromBinary.nodes_size(), static_cast<int>(scene.nodes.size()));
 
-    const std::string garbage = Write("garbage.scene.binpb", "version: PROTOCOL_VERSION_CURRENT\n");
+    const std::string garbage =
+        testing::WriteTempFile("garbage.scene.binpb", "version: PROTOCOL_VERSION_CURRENT\n");
     try {
         LoadSceneFile(garbage);
         ADD_FAILURE() << "a text file read as binary was accepted";
@@ -143,7 +140,7 @@ TEST(SceneFile, ReadsABinaryFileANodeAtATime) {
         *(i < 10 ? first : i < 40 ? second : third).add_nodes() = whole.nodes(i);
     const std::string bytes =
         first.SerializeAsString() + second.SerializeAsString() + third.SerializeAsString();
-    const std::string path = Write("interleaved.scene.binpb", bytes);
+    const std::string path = testing::WriteTempFile("interleaved.scene.binpb", bytes);
     EXPECT_TRUE(
         google::protobuf::util::MessageDifferencer::Equals(ToProto(LoadSceneFile(path)), whole));
 
@@ -156,7 +153,8 @@ TEST(SceneFile, ReadsABinaryFileANodeAtATime) {
         EXPECT_EQ(error.Field(), "nodes");
     }
 
-    const std::string cut = Write("cut.scene.binpb", bytes.substr(0, bytes.size() / 2));
+    const std::string cut =
+        testing::WriteTempFile("cut.scene.binpb", bytes.substr(0, bytes.size() / 2));
     try {
         LoadSceneFile(cut);
         ADD_FAILURE() << "a file cut short was accepted";
@@ -168,7 +166,7 @@ TEST(SceneFile, ReadsABinaryFileANodeAtATime) {
 
 TEST(SceneFile, ImportsCaribuWithItsOptics) {
     const std::string data = LEAFLUX_SHARED_DATA;
-    const Scene scene = LoadSceneFile(Write(
+    const Scene scene = LoadSceneFile(testing::WriteTempFile(
         "bac1.scene.txtpb",
         R"(
 bands { name: "PAR" } bands { name: "NIR" }
@@ -192,16 +190,16 @@ can_lights { path: ")" +
 
 TEST(SceneFile, ImportsObjAndOpfWithMaterialMaps) {
     const std::string data = LEAFLUX_SHARED_DATA;
-    const Scene scene = LoadSceneFile(
-        Write("mixed.scene.txtpb",
-              std::string(kHeader) + R"(
+    const Scene scene = LoadSceneFile(testing::WriteTempFile(
+        "mixed.scene.txtpb",
+        std::string(kHeader) + R"(
 optics { id: "bark" bands { key: "PAR" value { rho_upper: 0.2 rho_lower: 0.2 } } }
 nodes { id: 1 type: NODE_TYPE_PLANT name: "plant" }
 imports { path: ")" +
-                  data + R"(/leaves/RedbudLeaf.obj" default_optics: "leaf" parent: 1 id_offset: 100
+            data + R"(/leaves/RedbudLeaf.obj" default_optics: "leaf" parent: 1 id_offset: 100
           frame { m: [0.1, 0, 0, 1,  0, 0.1, 0, 0,  0, 0, 0.1, 0.5] } }
 imports { path: ")" +
-                  data + R"(/opf/simple_plant.opf" id_offset: 1000
+            data + R"(/opf/simple_plant.opf" id_offset: 1000
           material_optics { key: "material0" value: "bark" } material_optics { key: "material1" value: "leaf" } }
 )"));
     EXPECT_EQ(scene.nodes.size(), 1u + 1u + 7u);

@@ -10,15 +10,10 @@
 
 #include "leaflux.pb.h"
 #include "server/text_format.h"
+#include "tests/temp_file.h"
 
 namespace leaflux {
 namespace {
-
-std::string Write(const std::string& name, const std::string& text) {
-    const std::string path = ::testing::TempDir() + name;
-    std::ofstream(path) << text;
-    return path;
-}
 
 // The nodes of `path` taken apart, in order, and the rest.
 v1::Scene ReadSplit(const std::string& path, std::size_t& taken) {
@@ -57,7 +52,7 @@ nodes {
 )";
 
 TEST(SplitTextFile, TakesEveryNodeApartInOrderAndLeavesTheRest) {
-    const std::string path = Write("odd.scene.txtpb", kOddLayouts);
+    const std::string path = testing::WriteTempFile("odd.scene.txtpb", kOddLayouts);
     std::size_t taken = 0;
     const v1::Scene split = ReadSplit(path, taken);
     EXPECT_EQ(taken, 4u);
@@ -65,11 +60,11 @@ TEST(SplitTextFile, TakesEveryNodeApartInOrderAndLeavesTheRest) {
 }
 
 TEST(SplitTextFile, LeavesNodesThatShareALineInTheRest) {
-    const std::string path =
-        Write("shared.scene.txtpb", std::string(kOddLayouts) +
-                                        "nodes { id: 5 parent: 1 } nodes { id: 6 parent: 1 }\n"
-                                        "nodes { id: 7 parent: 1\n} bands { name: \"UV\" }\n"
-                                        "nodes: [{ id: 8 parent: 1 }]\n");
+    const std::string path = testing::WriteTempFile(
+        "shared.scene.txtpb", std::string(kOddLayouts) +
+                                  "nodes { id: 5 parent: 1 } nodes { id: 6 parent: 1 }\n"
+                                  "nodes { id: 7 parent: 1\n} bands { name: \"UV\" }\n"
+                                  "nodes: [{ id: 8 parent: 1 }]\n");
     SplitTextFile file(path, "nodes");
     v1::Scene rest;
     std::size_t taken = 0;
@@ -90,9 +85,10 @@ TEST(SplitTextFile, NamesAMistakeWhereTheWholeFilesParseDoes) {
     for (const auto& [what, mistake] :
          {std::pair{"in a node", "nodes {\n  id: 3001\n  nme: \"x\"\n}\n"},
           {"in the rest", "sky { discretisation: 3 }\n"},
-         {"a field given twice", "nodes {\n  id: 3001\n  id: 3002\n}\n"},
+          {"a field given twice", "nodes {\n  id: 3001\n  id: 3002\n}\n"},
           {"an unclosed node", "nodes {\n  id: 3001\n"}}) {
-        const std::string path = Write("mistake.scene.txtpb", many + mistake + many);
+        const std::string path =
+            testing::WriteTempFile("mistake.scene.txtpb", many + mistake + many);
         v1::Scene whole;
         const auto expected = ReadTextFormat(path, whole);
         ASSERT_TRUE(expected) << what;
