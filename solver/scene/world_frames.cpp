@@ -6,60 +6,22 @@
 #include <string>
 
 namespace leaflux {
-namespace {
-enum class State : std::uint8_t { kUnknown, kOnPath, kDone, kNone };
-}  // namespace
 
 WorldFrames::WorldFrames(const Scene& scene) {
-    const std::size_t n = scene.nodes.size();
-    // The nodes in the order of their ids.
-    std::vector<std::uint32_t> order(n);
-    std::iota(order.begin(), order.end(), 0u);
-    if (!std::is_sorted(scene.nodes.begin(), scene.nodes.end(),
-                        [](const Node& a, const Node& b) { return a.id < b.id; })) {
-        std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-            return scene.nodes[a].id < scene.nodes[b].id;
-        });
-    }
-    ids_.resize(n);
-    for (std::size_t k = 0; k < n; ++k) ids_[k] = scene.nodes[order[k]].id;
-    const auto slotOf = [&](NodeId id) -> std::int64_t {
-        const auto it = std::lower_bound(ids_.begin(), ids_.end(), id);
-        return it != ids_.end() && *it == id ? it - ids_.begin() : -1;
-    };
-    frames_.assign(n, glm::dmat4(1.0));
-    std::vector<State> state(n, State::kUnknown);
-    std::vector<std::uint32_t> path;  // slots from a node up to the first one known
-    for (std::uint32_t start = 0; start < n; ++start) {
-        path.clear();
-        State above = State::kDone;  // a root's parent: the world
-        std::int64_t known = -1;     // the slot the walk stopped at, if any
-        for (std::int64_t slot = start; slot >= 0;) {
-            if (state[slot] != State::kUnknown) {
-                above = state[slot] == State::kOnPath ? State::kNone : state[slot];
-                known = slot;
-                break;
-            }
-            state[slot] = State::kOnPath;
-            path.push_back(static_cast<std::uint32_t>(slot));
-            const NodeId parent = scene.nodes[order[slot]].parent;
-            if (parent == kNoParent) break;
-            slot = slotOf(parent);
-            if (slot < 0) above = State::kNone;
-        }
-        // Down the path, each frame from its parent's.
-        for (auto it = path.rbegin(); it != path.rend(); ++it) {
-            state[*it] = above;
-            if (above == State::kNone) continue;
-            const glm::dmat4& parentFromLocal = scene.nodes[order[*it]].parentFromLocal;
-            frames_[*it] = known < 0 ? parentFromLocal : frames_[known] * parentFromLocal;
-            known = *it;
-        }
-    }
-    // Nodes without a frame are taken out of the lookup.
+    ids_.reserve(scene.nodes.size());
+    for (const Node& node : scene.nodes) ids_.push_back(node.id);
+    std::sort(ids_.begin(), ids_.end());
+    frames_.assign(ids_.size(), glm::dmat4(1.0));
+    std::vector<std::uint8_t> framed(ids_.size(), 0);
+    ForEachWorldFrame(scene, [&](const Node& node, const glm::dmat4& frame) {
+        const std::size_t slot = std::lower_bound(ids_.begin(), ids_.end(), node.id) - ids_.begin();
+        frames_[slot] = frame;
+        framed[slot] = 1;
+    });
+    // Nodes the walk did not reach (their parent links loop or lead nowhere) have no frame.
     std::size_t kept = 0;
-    for (std::size_t k = 0; k < n; ++k) {
-        if (state[k] != State::kDone) continue;
+    for (std::size_t k = 0; k < ids_.size(); ++k) {
+        if (!framed[k]) continue;
         ids_[kept] = ids_[k];
         frames_[kept++] = frames_[k];
     }
