@@ -611,10 +611,14 @@ TEST(Instanced, OneCoreGivesTheLightOfEvery) {
 // The energy balance closes: what the suns and sky bring is absorbed or escapes, counting
 // what the closed instances send out of the scene. Plants without a ground, so that all
 // that escapes leaves the plants: before it was counted, the balance missed all of it (a
-// lone 1,000-leaf tree's 13 % of its PAR and 86 % of its NIR; here 84 % of the NIR). What
-// is left is the phase functions' own error: measured 0.07 % (PAR) and 0.49 % (NIR) with
-// every plant opened, and with the plants solved whole 2.2 and 1.3 %, where the absorption
-// of a plant solved whole carries its own tolerance (kWholeTolerance). The incident light
+// lone 1,000-leaf tree's 13 % of its PAR and 86 % of its NIR; here 84 % of the NIR). With
+// every plant opened, what escapes is counted from the leaves, whose light is the answer,
+// and the balance closes as HRC's does (the stability suite's 0.5 % and 4.6 standard
+// errors of the escape estimate): measured −0.02 % (PAR) and −0.14 % (NIR). Counted from
+// the phase functions of the plants at the top, as it was, it was 0.07 and 0.49 %, and on
+// a 10,000-leaf tree 5.9 % in NIR. Solved whole, the plants' phase functions are the answer:
+// 2.2 and 1.4 %, where the absorption of a plant solved whole carries its own tolerance
+// (kWholeTolerance). The incident light
 // is the suns' and sky's alone, as HRC has it: the first sweep at the top had counted what
 // the closed plants scattered of it too (the 10,000-leaf tree's NIR 2.7 % over HRC's,
 // hiding a balance 3.3 % short).
@@ -645,7 +649,8 @@ TEST(Instanced, TheEnergyBalanceClosesWithTheLightTheInstancesSendOut) {
             if (!whole) {
                 EXPECT_NEAR(balance.incidentW, incident, 0.005 * incident);
             }
-            EXPECT_LT(std::abs(balance.RelativeResidual()), whole ? kWholeTolerance[0] : 0.02);
+            const double opened = 0.005 + 4.6 * balance.stderrW / balance.incidentW;
+            EXPECT_LT(std::abs(balance.RelativeResidual()), whole ? kWholeTolerance[0] : opened);
         }
     }
 }

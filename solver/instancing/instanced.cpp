@@ -162,6 +162,8 @@ class InstancedSolve {
         return organs;
     }
     ShadowView ShadowsOf(std::uint32_t p, const FlatScene& flat) const;
+    // Adds `part` (sign 1) to `total` or takes it off (−1), the standard errors' squares too.
+    static void AddBalance(EnergyBalance& total, const EnergyBalance& part, double sign);
     // The light that arrived on closed instance c of `level`, as the sources of its contents.
     std::vector<DirectionalSource> ArrivedOn(const LevelSolution& light, std::size_t c) const;
     // Each patch side that sends light, as an emitter held fixed (ReceiverKind::kHeld).
@@ -361,17 +363,20 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     solution.stats.iterations =
         std::max(solution.stats.iterations, light.solution.stats.iterations);
     solution.stats.residual = std::max(solution.stats.residual, light.solution.stats.residual);
-    for (std::size_t b = 0; b < solution.balance.size(); ++b) {
-        solution.balance[b].absorbedW += light.solution.balance[b].absorbedW;
-        solution.balance[b].incidentW += light.solution.balance[b].incidentW;
-        // What leaves the top's surfaces; not what opened instances send out of the scene,
-        // which their phase functions sent at the top (instanced.h).
-        if (p == InstanceTree::kTop) {
-            solution.balance[b].escapedW = light.solution.balance[b].escapedW;
-            solution.balance[b].stderrW = light.solution.balance[b].stderrW;
-        }
-    }
+    // What escapes the scene from each level's organs and surfaces, and from its closed
+    // instances but those opened (OpenInstances): an opened one's organs say what leaves it.
+    for (std::size_t b = 0; b < solution.balance.size(); ++b)
+        AddBalance(solution.balance[b], light.solution.balance[b], 1.0);
     return light;
+}
+
+void InstancedSolve::AddBalance(EnergyBalance& total, const EnergyBalance& part, double sign) {
+    total.absorbedW += sign * part.absorbedW;
+    total.incidentW += sign * part.incidentW;
+    total.escapedW += sign * part.escapedW;
+    const double variance = std::max(total.stderrW, 0.0) * std::max(total.stderrW, 0.0) +
+                            sign * std::max(part.stderrW, 0.0) * std::max(part.stderrW, 0.0);
+    total.stderrW = std::sqrt(std::max(variance, 0.0));
 }
 
 std::vector<Emitter> InstancedSolve::Emitters(
@@ -501,6 +506,13 @@ void InstancedSolve::OpenInstances(const Level& level, const LevelSolution& ligh
         }
     }
     if (opened.empty()) return;
+    {
+        std::lock_guard lock(statsMutex_);
+        for (std::size_t c : opened) {
+            for (std::size_t b = 0; b < light.closedEscape[c].size(); ++b)
+                AddBalance(out_.solution.balance[b], light.closedEscape[c][b], -1.0);
+        }
+    }
     std::vector<std::vector<DirectionalSource>> arrived(opened.size());
     for (std::size_t i = 0; i < opened.size(); ++i) arrived[i] = ArrivedOn(light, opened[i]);
     // What they hold of this level and those further out (holdOutside): an instance's own

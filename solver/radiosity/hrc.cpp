@@ -6,7 +6,6 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -30,19 +29,6 @@
 
 namespace leaflux {
 namespace {
-
-class Stopwatch {
-  public:
-    double Lap() {
-        const auto now = std::chrono::steady_clock::now();
-        const double seconds = std::chrono::duration<double>(now - last_).count();
-        last_ = now;
-        return seconds;
-    }
-
-  private:
-    std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
 
 // Refine–solve passes after the first solution, and the Jacobi sweeps of each pass but the
 // last.
@@ -292,7 +278,8 @@ class SceneSolve {
     // At the scene's top: per channel, the lamps' light the closed instances intercepted on
     // its first arrival (ClosedLampIncident), incident light no level counts otherwise.
     std::vector<double> closedLampIncident_;
-    std::optional<ClosedResponse> closedResponse_;  // made on the first update
+    std::vector<std::vector<EnergyBalance>> closedEscape_;  // LevelSolution::closedEscape
+    std::optional<ClosedResponse> closedResponse_;          // made on the first update
     const std::unique_ptr<const Occlusion> ownOcclusion_;
     const Occlusion& occlusion_;
     const LevelProblem level_;  // its sources moved into sources_
@@ -611,12 +598,13 @@ void SceneSolve::Outputs(Solution& solution) {
         traversal_.Subtrees().empty() ? 0 : traversal_.Depth(hierarchy_, *active_));
     if (channels_.beams > 1) return;  // their light is read by Patches
     SolutionSink sink(solution);
-    // The scene's top level holding closed instances: what passes them, and what they send,
-    // escapes by their transmittance (a local problem's escape is not the scene's).
-    const bool top = !hierarchy_.Closed().empty() && !occlusion_.HasOutside();
+    // Holding closed instances, or within levels further out: what passes them, and what
+    // the closed ones send, escapes the scene by their transmittance.
+    const bool closed = !hierarchy_.Closed().empty() || occlusion_.HasOutside();
     rayCount_ += WriteOutputs(model_, rays_, traversal_.Leaves(), optics_, field_, leafLight_, sink,
-                              solution.balance, top ? &occlusion_ : nullptr);
-    if (top) rayCount_ += AddClosedEscape(model_, occlusion_, field_, solution.balance);
+                              solution.balance, closed ? &occlusion_ : nullptr);
+    if (closed)
+        rayCount_ += AddClosedEscape(model_, occlusion_, field_, solution.balance, &closedEscape_);
     for (std::size_t k = 0; k < closedLampIncident_.size(); ++k)
         solution.balance[k].incidentW += closedLampIncident_[k];
 }
@@ -626,6 +614,7 @@ void SceneSolve::Arrived(LevelSolution& level) const {
     level.errorW = thresholds_.errorW;
     level.sourceCount = thresholds_.sourceCount;
     level.bins = model_.BinCount();
+    level.closedEscape = closedEscape_;
     const std::size_t closed = hierarchy_.Closed().size();
     const std::size_t width = static_cast<std::size_t>(model_.BinCount()) * channels_.Count();
     level.arrivedBins.assign(closed, std::vector<double>(width, 0.0));

@@ -138,7 +138,8 @@ std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
 }
 
 std::int64_t AddClosedEscape(const NodeModel& model, const Occlusion& occlusion, const Field& field,
-                             std::vector<EnergyBalance>& balances) {
+                             std::vector<EnergyBalance>& balances,
+                             std::vector<std::vector<EnergyBalance>>* each) {
     const Hierarchy& hierarchy = model.Nodes();
     const DirectionSet& directions = model.Directions();
     const Channels& channels = model.ChannelSet();
@@ -186,13 +187,17 @@ std::int64_t AddClosedEscape(const NodeModel& model, const Occlusion& occlusion,
         }
     });
     std::int64_t rays = 0;
+    if (each != nullptr) each->assign(closed, std::vector<EnergyBalance>(balances.size()));
+    const auto add = [&](EnergyBalance& balance, std::size_t c, int k) {
+        const double before = std::max(balance.stderrW, 0.0);
+        balance.escapedW += escaped[c][k];
+        balance.stderrW = std::sqrt(before * before + variance[c][k]);
+    };
     for (std::size_t c = 0; c < closed; ++c) {
         rays += traced[c];
         for (int k = 0; k < count; ++k) {
-            EnergyBalance& balance = balances[channels.BandOf(k)];
-            const double before = std::max(balance.stderrW, 0.0);
-            balance.escapedW += escaped[c][k];
-            balance.stderrW = std::sqrt(before * before + variance[c][k]);
+            add(balances[channels.BandOf(k)], c, k);
+            if (each != nullptr) add((*each)[c][channels.BandOf(k)], c, k);
         }
     }
     return rays;

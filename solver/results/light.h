@@ -2,6 +2,7 @@
 // can be compared on the same scene (DESIGN §3).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <string>
@@ -72,6 +73,20 @@ class ResourceClock {
 
   private:
     double wallStart_, cpuStart_;
+};
+
+// Wall time in laps: each Lap, the seconds since the last (or since made).
+class Stopwatch {
+  public:
+    double Lap() {
+        const auto now = std::chrono::steady_clock::now();
+        const double seconds = std::chrono::duration<double>(now - last_).count();
+        last_ = now;
+        return seconds;
+    }
+
+  private:
+    std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
 // HRC's links of one kind against rays from their receivers (HrcOptions::auditLinks): the
