@@ -614,7 +614,7 @@ TEST(Instanced, OneCoreGivesTheLightOfEvery) {
 // lone 1,000-leaf tree's 13 % of its PAR and 86 % of its NIR; here 84 % of the NIR). With
 // every plant opened, what escapes is counted from the leaves, whose light is the answer,
 // and the balance closes as HRC's does (the stability suite's 0.5 % and 4.6 standard
-// errors of the escape estimate): measured −0.02 % (PAR) and −0.14 % (NIR). Counted from
+// errors of the escape estimate): measured −0.02 % (PAR) and −0.11 % (NIR). Counted from
 // the phase functions of the plants at the top, as it was, it was 0.07 and 0.49 %, and on
 // a 10,000-leaf tree 5.9 % in NIR. Solved whole, the plants' phase functions are the answer:
 // 2.2 and 1.4 %, where the absorption of a plant solved whole carries its own tolerance

@@ -598,8 +598,8 @@ void SceneSolve::Outputs(Solution& solution) {
         traversal_.Subtrees().empty() ? 0 : traversal_.Depth(hierarchy_, *active_));
     if (channels_.beams > 1) return;  // their light is read by Patches
     SolutionSink sink(solution);
-    // Holding closed instances, or within levels further out: what passes them, and what
-    // the closed ones send, escapes the scene by their transmittance.
+    // Holding closed instances, or within levels further out: what escapes passes the whole
+    // scene (WriteOutputs), and the closed ones' light by their transmittance.
     const bool closed = !hierarchy_.Closed().empty() || occlusion_.HasOutside();
     rayCount_ += WriteOutputs(model_, rays_, traversal_.Leaves(), optics_, field_, leafLight_, sink,
                               solution.balance, closed ? &occlusion_ : nullptr);

@@ -43,6 +43,20 @@ std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
     // ray agrees: a closed box's walls, whose every ray hits).
     std::vector<std::array<double, 2>> escape(leaves.size()), doubt(leaves.size());
     std::vector<std::int64_t> traces(leaves.size(), 0);
+    // With the whole scene's triangles (shadows by geometry), a ray escapes past every organ
+    // and surface of it, as it does for Monte Carlo, instead of through the closed
+    // instances' transmittance and each level further out in turn.
+    const ShadowView* shadows =
+        occlusion != nullptr && occlusion->Shadows().rays ? &occlusion->Shadows() : nullptr;
+    const auto passes = [&](const Hierarchy::Point& p, const glm::dvec3& omega) -> double {
+        if (shadows != nullptr && shadows->triangleOf[p.triangle] != kNoTriangle) {
+            const RayStart there{p.position + shadows->offset, shadows->triangleOf[p.triangle]};
+            return shadows->rays->Occluded(there, omega) ? 0.0 : 1.0;
+        }
+        const RayStart start{p.position, p.triangle};
+        if (occlusion != nullptr) return occlusion->Transmittance(start, omega);
+        return rays.Trace(start, omega).fate != RayFate::kHit ? 1.0 : 0.0;
+    };
     tbb::parallel_for(std::size_t{0}, leaves.size(), [&](std::size_t i) {
         SetFlushToZero();
         const HrcNode& node = hierarchy[leaves[i]];
@@ -63,10 +77,7 @@ std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
                 const glm::dvec3 n = s == kUpper ? node.normal : -node.normal;
                 const glm::dvec3 omega =
                     CosineHemisphere(n, (k + random.Uniform()) / count, random.Uniform());
-                const RayStart start{p.position, p.triangle};
-                const double passed =
-                    occlusion ? occlusion->Transmittance(start, omega)
-                              : static_cast<double>(rays.Trace(start, omega).fate != RayFate::kHit);
+                const double passed = passes(p, omega);
                 out += passed, squares += passed * passed;
             }
             // The mean's variance from the rays' own spread (for rays that pass or not,

@@ -39,8 +39,10 @@ class SolutionSink : public LightSink {
 
 // Hands each receiver of the leaf patches `leaves` to the sink and adds their energy
 // balance to `balances` (one per band); returns the rays it traced. A scene's solve: one
-// channel per band. With `occlusion` (a level holding closed instances), the escape rays
-// pass its closed instances by their transmittance, else they meet `rays`' triangles alone.
+// channel per band. With `occlusion` (a level holding closed instances, or within levels
+// further out), the escape rays meet the whole scene's triangles where it has them
+// (Occlusion::Shadows), else they pass its closed instances by their transmittance and
+// the levels further out; without, they meet `rays`' triangles alone.
 std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
                           const std::vector<std::uint32_t>& leaves, const ReceiverOptics& optics,
                           const Field& field, const LeafLight& leafLight, LightSink& sink,
