@@ -162,8 +162,6 @@ class InstancedSolve {
         return organs;
     }
     ShadowView ShadowsOf(std::uint32_t p, const FlatScene& flat) const;
-    // Adds `part` (sign 1) to `total` or takes it off (−1), the standard errors' squares too.
-    static void AddBalance(EnergyBalance& total, const EnergyBalance& part, double sign);
     // The light that arrived on closed instance c of `level`, as the sources of its contents.
     std::vector<DirectionalSource> ArrivedOn(const LevelSolution& light, std::size_t c) const;
     // Each patch side that sends light, as an emitter held fixed (ReceiverKind::kHeld).
@@ -269,6 +267,7 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
         closed.boxMax = instance.boxMax;
         closed.areaM2 = instance.leafAreaM2;
         closed.organArea = instance.area;
+        closed.opens = Opens(q, level->worldFromClosed[j]);
         ShadowTriangles(q, closed);
         const std::shared_ptr<const Original>& original =
             originals_.bySignature.at(instance.signature);
@@ -364,19 +363,17 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
         std::max(solution.stats.iterations, light.solution.stats.iterations);
     solution.stats.residual = std::max(solution.stats.residual, light.solution.stats.residual);
     // What escapes the scene from each level's organs and surfaces, and from its closed
-    // instances but those opened (OpenInstances): an opened one's organs say what leaves it.
-    for (std::size_t b = 0; b < solution.balance.size(); ++b)
-        AddBalance(solution.balance[b], light.solution.balance[b], 1.0);
+    // instances that are not opened (ClosedNode::opens): an opened one's organs say what
+    // leaves it.
+    for (std::size_t b = 0; b < solution.balance.size(); ++b) {
+        EnergyBalance& total = solution.balance[b];
+        const EnergyBalance& part = light.solution.balance[b];
+        total.absorbedW += part.absorbedW;
+        total.incidentW += part.incidentW;
+        total.escapedW += part.escapedW;
+        total.stderrW = std::hypot(std::max(total.stderrW, 0.0), std::max(part.stderrW, 0.0));
+    }
     return light;
-}
-
-void InstancedSolve::AddBalance(EnergyBalance& total, const EnergyBalance& part, double sign) {
-    total.absorbedW += sign * part.absorbedW;
-    total.incidentW += sign * part.incidentW;
-    total.escapedW += sign * part.escapedW;
-    const double variance = std::max(total.stderrW, 0.0) * std::max(total.stderrW, 0.0) +
-                            sign * std::max(part.stderrW, 0.0) * std::max(part.stderrW, 0.0);
-    total.stderrW = std::sqrt(std::max(variance, 0.0));
 }
 
 std::vector<Emitter> InstancedSolve::Emitters(
@@ -506,13 +503,6 @@ void InstancedSolve::OpenInstances(const Level& level, const LevelSolution& ligh
         }
     }
     if (opened.empty()) return;
-    {
-        std::lock_guard lock(statsMutex_);
-        for (std::size_t c : opened) {
-            for (std::size_t b = 0; b < light.closedEscape[c].size(); ++b)
-                AddBalance(out_.solution.balance[b], light.closedEscape[c][b], -1.0);
-        }
-    }
     std::vector<std::vector<DirectionalSource>> arrived(opened.size());
     for (std::size_t i = 0; i < opened.size(); ++i) arrived[i] = ArrivedOn(light, opened[i]);
     // What they hold of this level and those further out (holdOutside): an instance's own

@@ -59,6 +59,9 @@ struct ClosedNode {
     std::shared_ptr<const RayScene::TriangleRanges> shadowTriangles;
     // Where its organs lie in its box, when known; else its light leaves evenly from the box.
     std::shared_ptr<const AreaGrid> organArea;
+    // Opened once its level is solved: what leaves the scene from it is counted from its
+    // organs (the energy balance), not from what its phase function sends.
+    bool opens = false;
 
     bool Held() const { return !held.empty(); }
 

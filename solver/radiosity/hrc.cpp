@@ -278,8 +278,7 @@ class SceneSolve {
     // At the scene's top: per channel, the lamps' light the closed instances intercepted on
     // its first arrival (ClosedLampIncident), incident light no level counts otherwise.
     std::vector<double> closedLampIncident_;
-    std::vector<std::vector<EnergyBalance>> closedEscape_;  // LevelSolution::closedEscape
-    std::optional<ClosedResponse> closedResponse_;          // made on the first update
+    std::optional<ClosedResponse> closedResponse_;  // made on the first update
     const std::unique_ptr<const Occlusion> ownOcclusion_;
     const Occlusion& occlusion_;
     const LevelProblem level_;  // its sources moved into sources_
@@ -603,8 +602,7 @@ void SceneSolve::Outputs(Solution& solution) {
     const bool closed = !hierarchy_.Closed().empty() || occlusion_.HasOutside();
     rayCount_ += WriteOutputs(model_, rays_, traversal_.Leaves(), optics_, field_, leafLight_, sink,
                               solution.balance, closed ? &occlusion_ : nullptr);
-    if (closed)
-        rayCount_ += AddClosedEscape(model_, occlusion_, field_, solution.balance, &closedEscape_);
+    if (closed) rayCount_ += AddClosedEscape(model_, occlusion_, field_, solution.balance);
     for (std::size_t k = 0; k < closedLampIncident_.size(); ++k)
         solution.balance[k].incidentW += closedLampIncident_[k];
 }
@@ -614,7 +612,6 @@ void SceneSolve::Arrived(LevelSolution& level) const {
     level.errorW = thresholds_.errorW;
     level.sourceCount = thresholds_.sourceCount;
     level.bins = model_.BinCount();
-    level.closedEscape = closedEscape_;
     const std::size_t closed = hierarchy_.Closed().size();
     const std::size_t width = static_cast<std::size_t>(model_.BinCount()) * channels_.Count();
     level.arrivedBins.assign(closed, std::vector<double>(width, 0.0));

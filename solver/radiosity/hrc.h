@@ -203,9 +203,6 @@ struct LevelSolution {
     // With LevelProblem::holdLevel: per closed instance (not held), its intensity as solved,
     // [bin][channel] in W/sr (ClosedNode::held); `surfaces` then has the organs' triangles too.
     std::vector<std::vector<double>> closedIntensity;
-    // Per closed instance and band, what it sends out of the scene (escapedW, stderrW), in
-    // the solution's balance: an instance opened in turn has its organs' escape instead.
-    std::vector<std::vector<EnergyBalance>> closedEscape;
 };
 LevelSolution SolveLevel(const Scene& scene, const FlatScene& flat, const RayScene& rays,
                          const HrcOptions& options, std::span<const ClosedNode> closed,

@@ -49,11 +49,13 @@ std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
     const ShadowView* shadows =
         occlusion != nullptr && occlusion->Shadows().rays ? &occlusion->Shadows() : nullptr;
     const auto passes = [&](const Hierarchy::Point& p, const glm::dvec3& omega) -> double {
+        const RayStart start{p.position, p.triangle};
         if (shadows != nullptr && shadows->triangleOf[p.triangle] != kNoTriangle) {
+            // The level's own triangles first: most rays they stop need no more.
+            if (rays.Occluded(start, omega)) return 0.0;
             const RayStart there{p.position + shadows->offset, shadows->triangleOf[p.triangle]};
             return shadows->rays->Occluded(there, omega) ? 0.0 : 1.0;
         }
-        const RayStart start{p.position, p.triangle};
         if (occlusion != nullptr) return occlusion->Transmittance(start, omega);
         return rays.Trace(start, omega).fate != RayFate::kHit ? 1.0 : 0.0;
     };
@@ -149,8 +151,7 @@ std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
 }
 
 std::int64_t AddClosedEscape(const NodeModel& model, const Occlusion& occlusion, const Field& field,
-                             std::vector<EnergyBalance>& balances,
-                             std::vector<std::vector<EnergyBalance>>* each) {
+                             std::vector<EnergyBalance>& balances) {
     const Hierarchy& hierarchy = model.Nodes();
     const DirectionSet& directions = model.Directions();
     const Channels& channels = model.ChannelSet();
@@ -164,7 +165,8 @@ std::int64_t AddClosedEscape(const NodeModel& model, const Occlusion& occlusion,
     tbb::parallel_for(std::size_t{0}, closed, [&](std::size_t c) {
         SetFlushToZero();
         const ClosedNode& node = hierarchy.Closed()[c];
-        if (node.Held()) return;  // its light is the level's that holds it
+        // A held one's light is the level's that holds it; an opened one's, its organs'.
+        if (node.Held() || node.opens) return;
         const double* sent =
             field.intensity[model.Slot(hierarchy.NodeOfClosed(static_cast<std::int32_t>(c)))];
         const std::uint32_t self = static_cast<std::uint32_t>(c);
@@ -198,17 +200,13 @@ std::int64_t AddClosedEscape(const NodeModel& model, const Occlusion& occlusion,
         }
     });
     std::int64_t rays = 0;
-    if (each != nullptr) each->assign(closed, std::vector<EnergyBalance>(balances.size()));
-    const auto add = [&](EnergyBalance& balance, std::size_t c, int k) {
-        const double before = std::max(balance.stderrW, 0.0);
-        balance.escapedW += escaped[c][k];
-        balance.stderrW = std::sqrt(before * before + variance[c][k]);
-    };
     for (std::size_t c = 0; c < closed; ++c) {
         rays += traced[c];
         for (int k = 0; k < count; ++k) {
-            add(balances[channels.BandOf(k)], c, k);
-            if (each != nullptr) add((*each)[c][channels.BandOf(k)], c, k);
+            EnergyBalance& balance = balances[channels.BandOf(k)];
+            const double before = std::max(balance.stderrW, 0.0);
+            balance.escapedW += escaped[c][k];
+            balance.stderrW = std::sqrt(before * before + variance[c][k]);
         }
     }
     return rays;

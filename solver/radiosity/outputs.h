@@ -53,11 +53,9 @@ std::int64_t WriteOutputs(const NodeModel& model, const RayScene& rays,
 // bin of the cluster light's set, what it sends that way (its intensity times the bin's
 // solid angle) times the fraction of rays from points of its box, along the bin's
 // direction, that pass the rest of the scene (triangles block them, other closed instances
-// pass them by their transmittance). Its standard error goes into stderrW. With `each`,
-// also each instance's part ([closed][band]: escapedW and stderrW; none for a held one).
-// Returns the rays traced.
+// pass them by their transmittance). Its standard error goes into stderrW. Held instances
+// and those opened later (ClosedNode::opens) are left out. Returns the rays traced.
 std::int64_t AddClosedEscape(const NodeModel& model, const Occlusion& occlusion, const Field& field,
-                             std::vector<EnergyBalance>& balances,
-                             std::vector<std::vector<EnergyBalance>>* each = nullptr);
+                             std::vector<EnergyBalance>& balances);
 
 }  // namespace leaflux
