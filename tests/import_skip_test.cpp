@@ -12,15 +12,12 @@
 #include "solver/scene/world_frames.h"
 #include "solver/solve.h"
 #include "solver/util/error.h"
+#include "tests/temp_file.h"
 
 namespace leaflux {
 namespace {
 
-std::string TemporaryFile(const std::string& name, const std::string& text) {
-    const std::string path = ::testing::TempDir() + name;
-    std::ofstream(path) << text;
-    return path;
-}
+using testing::WriteTempFile;
 
 // The 1-based line of the first `needle` after the first `after` in `text`.
 int LineOf(const std::string& text, const std::string& needle, const std::string& after = "") {
@@ -101,7 +98,7 @@ const Node& NodeWithId(const ImportedGeometry& g, NodeId id) {
 
 TEST(OpfSkip, ZeroLengthInternodeAndNaNDiametersAreSkippedAndNamed) {
     const std::string text = MeasuredPlant();
-    const std::string path = TemporaryFile("measured.opf", text);
+    const std::string path = WriteTempFile("measured.opf", text);
     const ImportedGeometry g = ReadOpf(path);
     ASSERT_EQ(g.nodes.size(), 8u);  // every node stays in the topology
     EXPECT_FALSE(NodeWithId(g, 5).organ);
@@ -140,7 +137,7 @@ TEST(OpfSkip, ZeroLengthInternodeAndNaNDiametersAreSkippedAndNamed) {
 
 TEST(OpfSkip, StrictRefusesNamingTheNodeAndLine) {
     const std::string text = MeasuredPlant();
-    const std::string path = TemporaryFile("measured_strict.opf", text);
+    const std::string path = WriteTempFile("measured_strict.opf", text);
     const InputError singular = ErrorOf([&] { ReadOpf(path, ImportOptions{true}); });
     EXPECT_EQ(singular.Code(), ErrorCode::kDegenerate);
     EXPECT_EQ(singular.Node(), 5u);
@@ -149,7 +146,7 @@ TEST(OpfSkip, StrictRefusesNamingTheNodeAndLine) {
 
     // With the second internode mended, the NaN diameters of the third are what is refused.
     const std::string mended = MeasuredPlant(Upright(10, 10));
-    const std::string mendedPath = TemporaryFile("measured_nan.opf", mended);
+    const std::string mendedPath = WriteTempFile("measured_nan.opf", mended);
     EXPECT_TRUE(ReadOpf(mendedPath).skipped.size() == 1u);
     const InputError nan = ErrorOf([&] { ReadOpf(mendedPath, ImportOptions{true}); });
     EXPECT_EQ(nan.Node(), 7u);
@@ -159,8 +156,8 @@ TEST(OpfSkip, StrictRefusesNamingTheNodeAndLine) {
 }
 
 TEST(OpfSkip, TheRestOfThePlantIsLitAndStrictKeepsTheRefusal) {
-    const std::string opf = TemporaryFile("lit.opf", MeasuredPlant());
-    const std::string scenePath = TemporaryFile("lit.scene.txtpb", R"(
+    const std::string opf = WriteTempFile("lit.opf", MeasuredPlant());
+    const std::string scenePath = WriteTempFile("lit.scene.txtpb", R"(
 bands { name: "PAR" }
 optics { id: "bark" bands { key: "PAR" value { rho_upper: 0.1 rho_lower: 0.1 } } }
 optics { id: "leaf" bands { key: "PAR" value { rho_upper: 0.1 rho_lower: 0.1 tau_upper: 0.05 tau_lower: 0.05 } } }
@@ -206,7 +203,7 @@ std::string FlatteningFrames() {
 }
 
 TEST(OpfSkip, AFrameThatFlattensPartOfASharedMeshCopiesItForThatOrganOnly) {
-    const std::string path = TemporaryFile("flattening.opf", FlatteningFrames());
+    const std::string path = WriteTempFile("flattening.opf", FlatteningFrames());
     const ImportedGeometry g = ReadOpf(path);
     const Node& upright = NodeWithId(g, 2);
     const Node& flattened = NodeWithId(g, 3);
@@ -247,7 +244,7 @@ TEST(ObjSkip, ZeroAreaFacesAreSkippedByLineAndStrictRefusesThem) {
         "f 1 2 2\n"                                               // 10: repeated vertex
         "f 1 2 3 6\n"                                             // 11: second fan triangle flat
         "g speck\nf 1 1 1\n";                                     // 12-13: an organ of nothing
-    const std::string path = TemporaryFile("flat.obj", text);
+    const std::string path = WriteTempFile("flat.obj", text);
     const ImportedGeometry g = ReadObj(path);
     ASSERT_EQ(g.nodes.size(), 2u);
     ASSERT_TRUE(g.nodes[0].organ);
@@ -263,7 +260,7 @@ TEST(ObjSkip, ZeroAreaFacesAreSkippedByLineAndStrictRefusesThem) {
     EXPECT_EQ(strict.Field(), path + ":9");
     // Nothing left that carries light: refused, whatever the options.
     EXPECT_EQ(
-        ErrorOf([&] { ReadObj(TemporaryFile("dust.obj", "v 0 0 0\nv 1 0 0\nf 1 2 2\n")); }).Code(),
+        ErrorOf([&] { ReadObj(WriteTempFile("dust.obj", "v 0 0 0\nv 1 0 0\nf 1 2 2\n")); }).Code(),
         ErrorCode::kDegenerate);
 }
 
@@ -274,7 +271,7 @@ TEST(CanSkip, ZeroAreaPolygonsAreSkippedByLineAndStrictRefusesThem) {
         "p 1 100001002001 3 0 0 1 0 0 1 0 0 1\n"        // another leaf, a point
         "p 1 000000000001 4 0 0 0 1 0 0 1 1 0 2 2 0\n"  // soil; its second triangle is flat
         "p 1 000000000002 3 0 0 0 2 0 0 0 2 0\n";       // soil
-    const std::string path = TemporaryFile("flat.can", text);
+    const std::string path = WriteTempFile("flat.can", text);
     const ImportedGeometry g = ReadCan(path);
     int organs = 0;
     for (const Node& node : g.nodes) organs += node.organ.has_value();
@@ -291,21 +288,21 @@ TEST(CanSkip, ZeroAreaPolygonsAreSkippedByLineAndStrictRefusesThem) {
 }
 
 TEST(ImportErrors, OpfErrorsNameTheFileAndLine) {
-    const std::string unclosed = TemporaryFile("unclosed.opf", "<opf>\n<meshBDD>\n</opf>\n");
+    const std::string unclosed = WriteTempFile("unclosed.opf", "<opf>\n<meshBDD>\n</opf>\n");
     const InputError xml = ErrorOf([&] { ReadOpf(unclosed); });
     EXPECT_EQ(xml.Code(), ErrorCode::kParse);
     EXPECT_EQ(xml.Field(), unclosed + ":3") << xml.what();
 
     std::string text = MeasuredPlant(Upright(10, 10));
     text.replace(text.find("5 0 0 2"), 7, "5 0 x 2");  // leaf 6's mat
-    const std::string badMat = TemporaryFile("badmat.opf", text);
+    const std::string badMat = WriteTempFile("badmat.opf", text);
     const InputError mat = ErrorOf([&] { ReadOpf(badMat); });
     EXPECT_EQ(mat.Field(), badMat + ":" + std::to_string(LineOf(text, "<mat>", "id=\"6\"")));
     EXPECT_NE(std::string(mat.what()).find("'x'"), std::string::npos) << mat.what();
 
     text = MeasuredPlant(Upright(10, 10));
     text.replace(text.find("<shapeIndex>1</shapeIndex>"), 26, "<shapeIndex>9</shapeIndex>");
-    const std::string badShape = TemporaryFile("badshape.opf", text);
+    const std::string badShape = WriteTempFile("badshape.opf", text);
     const InputError shape = ErrorOf([&] { ReadOpf(badShape); });
     EXPECT_EQ(shape.Code(), ErrorCode::kNotFound);
     EXPECT_EQ(shape.Node(), 6u);  // leaf 6 is the first to use shape 1 in document order
@@ -313,7 +310,7 @@ TEST(ImportErrors, OpfErrorsNameTheFileAndLine) {
 }
 
 TEST(ImportErrors, ObjErrorsNameTheFileAndLine) {
-    const std::string path = TemporaryFile("words.obj", "v 0 0 0\nv 1 0 0\n\nv 0 one 0\n");
+    const std::string path = WriteTempFile("words.obj", "v 0 0 0\nv 1 0 0\n\nv 0 one 0\n");
     const InputError e = ErrorOf([&] { ReadObj(path); });
     EXPECT_EQ(e.Code(), ErrorCode::kParse);
     EXPECT_EQ(e.Field(), path + ":4");
@@ -325,7 +322,7 @@ TEST(ImportErrors, SharedMeshErrorsNameTheMeshAndListPosition) {
     std::string text = MeasuredPlant(Upright(10, 10));
     const std::size_t mesh1 = text.find("<mesh name=\"\" Id=\"1\">");
     text.replace(text.find("0 2 3", mesh1), 5, "0 2 7");
-    const std::string path = TemporaryFile("badface.opf", text);
+    const std::string path = WriteTempFile("badface.opf", text);
     const InputError opf = ErrorOf([&] { ReadOpf(path); });
     EXPECT_NE(std::string(opf.what()).find("meshBDD mesh 1, faces[1]"), std::string::npos)
         << opf.what();
@@ -333,7 +330,7 @@ TEST(ImportErrors, SharedMeshErrorsNameTheMeshAndListPosition) {
 
     // Scene files: a shared mesh's zero-area triangle is named by the mesh and its position,
     // not by whichever organ was checked first.
-    const std::string scene = TemporaryFile("shared.scene.txtpb", R"(
+    const std::string scene = WriteTempFile("shared.scene.txtpb", R"(
 bands { name: "PAR" }
 optics { id: "leaf" bands { key: "PAR" value { rho_upper: 0.1 rho_lower: 0.1 } } }
 meshes { key: "blade" value { positions: [0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0] triangles: [0, 1, 2, 0, 1, 3] } }
@@ -347,7 +344,7 @@ nodes { id: 2 name: "b" organ { optics: "leaf" mesh_ref: "blade" } }
 }
 
 TEST(ImportErrors, HugeCoordinatesAreOutOfRangeNotZeroArea) {
-    const std::string obj = TemporaryFile("far.obj", "v 0 0 0\nv 1e300 0 0\nv 0 1 0\nf 1 2 3\n");
+    const std::string obj = WriteTempFile("far.obj", "v 0 0 0\nv 1e300 0 0\nv 0 1 0\nf 1 2 3\n");
     const InputError read = ErrorOf([&] { ReadObj(obj); });
     EXPECT_EQ(read.Field(), obj + ":2");
     EXPECT_NE(std::string(read.what()).find("out of range"), std::string::npos) << read.what();
@@ -355,7 +352,7 @@ TEST(ImportErrors, HugeCoordinatesAreOutOfRangeNotZeroArea) {
     // An OPF frame that throws a leaf 1e300 cm away.
     std::string text = MeasuredPlant(Upright(10, 10));
     text.replace(text.find("5 0 0 2"), 7, "5 0 0 1e300");
-    const std::string opf = TemporaryFile("far.opf", text);
+    const std::string opf = WriteTempFile("far.opf", text);
     for (bool strict : {false, true}) {
         const InputError placed = ErrorOf([&] { ReadOpf(opf, ImportOptions{strict}); });
         EXPECT_EQ(placed.Code(), ErrorCode::kInvalidArgument);

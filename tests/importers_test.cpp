@@ -10,17 +10,14 @@
 #include "solver/scene/scene.h"
 #include "solver/scene/world_frames.h"
 #include "solver/util/error.h"
+#include "tests/temp_file.h"
 
 namespace leaflux {
 namespace {
 
 std::string Data(const std::string& name) { return std::string(LEAFLUX_SHARED_DATA) + "/" + name; }
 
-std::string TemporaryFile(const std::string& name, const std::string& text) {
-    const std::string path = ::testing::TempDir() + name;
-    std::ofstream(path) << text;
-    return path;
-}
+using testing::WriteTempFile;
 
 int TriangleCount(const ImportedGeometry& g) {
     int count = 0;
@@ -44,7 +41,7 @@ TEST(ReadObj, ReadsEachLeafPrototypeAsOneNamedOrgan) {
 
 TEST(ReadObj, SplitsGroupsAndMaterials) {
     const std::string path =
-        TemporaryFile("groups.obj",
+        WriteTempFile("groups.obj",
                       "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                       "g stem\nusemtl bark\nf 1 2 3\n"
                       "g blade\nusemtl green\nf 1 3 4\nusemtl yellow\nf -4 -3 -1\n");
@@ -59,13 +56,13 @@ TEST(ReadObj, SplitsGroupsAndMaterials) {
 
 TEST(ReadObj, RejectsBadFacesWithFileAndLine) {
     try {
-        ReadObj(TemporaryFile("bad.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7\n"));
+        ReadObj(WriteTempFile("bad.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7\n"));
         FAIL();
     } catch (const InputError& e) {
         EXPECT_EQ(e.Code(), ErrorCode::kParse);
         EXPECT_NE(e.Field().find("bad.obj:3"), std::string::npos) << e.what();
     }
-    EXPECT_THROW(ReadObj(TemporaryFile("nan.obj", "v 0 0 nan\n")), InputError);
+    EXPECT_THROW(ReadObj(WriteTempFile("nan.obj", "v 0 0 nan\n")), InputError);
     EXPECT_THROW(ReadObj(Data("no/such/file.obj")), InputError);
 }
 
@@ -88,12 +85,12 @@ TEST(ReadCan, DecodesLabelsOfTheSeedlingTray) {
 TEST(ReadCan, ReadsSoilAsEnvironment) {
     const ImportedGeometry g = ReadCan(Data("caribu/test.can"));
     ASSERT_EQ(g.environment.size(), 0u);  // test.can has no species-0 polygon
-    const ImportedGeometry s = ReadCan(TemporaryFile("soil.can",
+    const ImportedGeometry s = ReadCan(WriteTempFile("soil.can",
                                                      "p 1 000000000001 3 0 0 0 1 0 0 0 1 0\n"
                                                      "p 1 100001001001 3 0 0 1 1 0 1 0 1 1\n"));
     ASSERT_EQ(s.environment.size(), 1u);
     EXPECT_EQ(s.environment[0].opticsId, "soil");
-    EXPECT_THROW(ReadCan(TemporaryFile("badlabel.can", "p 1 12ab 3 0 0 0 1 0 0 0 1 0\n")),
+    EXPECT_THROW(ReadCan(WriteTempFile("badlabel.can", "p 1 12ab 3 0 0 0 1 0 0 0 1 0\n")),
                  InputError);
 }
 
@@ -149,8 +146,8 @@ TEST(ReadOpf, KeepsSharedMeshesAndTheTopology) {
 }
 
 TEST(ReadOpf, RejectsMalformedXml) {
-    EXPECT_THROW(ReadOpf(TemporaryFile("bad.opf", "<opf><meshBDD></opf>")), InputError);
-    EXPECT_THROW(ReadOpf(TemporaryFile(
+    EXPECT_THROW(ReadOpf(WriteTempFile("bad.opf", "<opf><meshBDD></opf>")), InputError);
+    EXPECT_THROW(ReadOpf(WriteTempFile(
                      "nomesh.opf",
                      "<opf><topology class=\"Scene\" "
                      "id=\"1\"><geometry><shapeIndex>3</shapeIndex></geometry></topology></opf>")),

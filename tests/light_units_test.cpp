@@ -75,7 +75,7 @@ TEST(PhotonUnits, AScenesFactorRoundTripsAndABadOneIsRefusedByField) {
         testing::WriteTempFile("photons.scene.txtpb", PlateScene(bands, Sun(400, 300))));
     EXPECT_EQ(scene.bands[0].photonUmolPerJ, 0.0);  // as given: the default is PhotonUmolPerJ's
     EXPECT_EQ(scene.bands[1].photonUmolPerJ, 9.5);
-    const std::string path = ::testing::TempDir() + "photons_again.scene.txtpb";
+    const std::string path = testing::TempPath("photons_again.scene.txtpb");
     SaveSceneFile(scene, path);
     EXPECT_EQ(LoadSceneFile(path).bands[1].photonUmolPerJ, 9.5);
 

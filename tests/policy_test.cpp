@@ -21,6 +21,7 @@
 #include "solver/instancing/signature.h"
 #include "solver/util/error.h"
 #include "tests/scene_builders.h"
+#include "tests/temp_file.h"
 
 namespace leaflux {
 namespace {
@@ -33,17 +34,8 @@ std::string PolicyPath(const std::string& name) {
     return std::string(LEAFLUX_SOURCE_DIR) + "/proto/policies/" + name;
 }
 
-// A file of the running test's own (ctest runs tests side by side, each in a process).
-std::string TempPath(const std::string& name) {
-    const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
-    return ::testing::TempDir() + test->test_suite_name() + "." + test->name() + "." + name;
-}
-
-std::string Write(const std::string& name, const std::string& text) {
-    const std::string path = TempPath(name);
-    std::ofstream(path) << text;
-    return path;
-}
+using testing::TempPath;
+using testing::WriteTempFile;
 
 const char* kMinimal = R"(species: "test"
 instance_types: [NODE_TYPE_AXIS]
@@ -55,7 +47,7 @@ transmittance { kind: FUNCTION_KIND_MONO level: 3 }
 
 // The error a policy text (kMinimal followed by `extra`, or `text` alone) raises.
 InputError FileError(const std::string& text) {
-    const std::string path = Write("bad_policy.txtpb", text);
+    const std::string path = WriteTempFile("bad_policy.txtpb", text);
     try {
         LoadPolicyFile(path);
     } catch (const InputError& e) {
@@ -122,7 +114,7 @@ TEST(PolicyFile, ShippedPoliciesParseAndValidate) {
 
 TEST(PolicyFile, UnknownFieldNamesFileLineAndColumn) {
     const std::string text = std::string(kMinimal) + "leaf_counts { edges: [1, 2] }\n";
-    const std::string path = Write("bad_policy.txtpb", text);
+    const std::string path = WriteTempFile("bad_policy.txtpb", text);
     const InputError e = FileError(text);
     EXPECT_EQ(e.Code(), ErrorCode::kParse);
     // Line 7; protobuf's tokenizer reports the column of the token after the unknown name.
@@ -352,7 +344,7 @@ TEST(PolicyHash, ChangesWithEveryField) {
 
 TEST(PolicyHash, IgnoresLayoutAndComments) {
     const InstancingPolicy shipped = LoadPolicyFile(PolicyPath("default.txtpb"));
-    const std::string path = Write("relaid_policy.txtpb", R"(
+    const std::string path = WriteTempFile("relaid_policy.txtpb", R"(
 # the default policy again, laid out otherwise
 species:"default"   version:PROTOCOL_VERSION_CURRENT
 instance_types: NODE_TYPE_AXIS   # one at a time, in another order
@@ -368,7 +360,7 @@ transmittance { direction_count: 130 kind: FUNCTION_KIND_MONO }
 phase { level: 3 kind: FUNCTION_KIND_BI }
 )");
     EXPECT_EQ(PolicyContentHash(LoadPolicyFile(path)), PolicyContentHash(shipped));
-    const std::string changed = Write("changed_policy.txtpb", R"(
+    const std::string changed = WriteTempFile("changed_policy.txtpb", R"(
 species: "default" instance_types: [NODE_TYPE_PLANT, NODE_TYPE_AXIS] by_type: true
 leaf_count { edges: [11, 100, 1000, 10000] }
 fixed { type: NODE_TYPE_PLANT leaf_count_above: 10000 }

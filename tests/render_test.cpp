@@ -17,6 +17,7 @@
 #include "solver/solve.h"
 #include "solver/util/error.h"
 #include "tests/scene_builders.h"
+#include "tests/temp_file.h"
 
 namespace leaflux {
 namespace {
@@ -195,7 +196,7 @@ TEST(Render, ASolutionReadBackFromItsCsvDrawsTheSamePicture) {
     const Scene scene = Plates({0.0, 30.0, 60.0}, 500.0);
     const PreparedScene prepared(scene);
     const Solution solution = SolveHrc(prepared);
-    const std::string path = ::testing::TempDir() + "render_plates.csv";
+    const std::string path = testing::TempPath("render_plates.csv");
     {
         std::ofstream out(path);
         WriteLeafCsv(out, scene, prepared.Flat(), solution);
@@ -211,7 +212,7 @@ TEST(Render, ASolutionReadBackFromItsCsvDrawsTheSamePicture) {
         for (int x = 0; x < a.image.Width(); ++x)
             ASSERT_EQ(a.image.At(x, y), b.image.At(x, y)) << x << "," << y;
     // And written as PNG, read back pixel for pixel.
-    const std::string png = ::testing::TempDir() + "render_plates.png";
+    const std::string png = testing::TempPath("render_plates.png");
     WritePng(a.image, png);
     const Image back = ReadPng(png);
     ASSERT_EQ(back.Width(), a.image.Width());
@@ -223,7 +224,7 @@ TEST(Render, ASolutionReadBackFromItsCsvDrawsTheSamePicture) {
 TEST(Render, ACsvThatDoesNotMatchTheSceneIsRefusedNamingItsLine) {
     const Scene scene = Plates({0.0}, 100.0);
     const FlatScene flat = Flatten(scene);
-    const std::string path = ::testing::TempDir() + "render_bad.csv";
+    const std::string path = testing::TempPath("render_bad.csv");
     const auto refusal = [&](const std::string& text) -> std::string {
         std::ofstream(path) << text;
         try {

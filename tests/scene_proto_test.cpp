@@ -55,8 +55,7 @@ TEST(SceneFile, RoundTripsAGeneratedTreeKeepingSharedMeshes) {
     tree.leafCount = 50;
     AddTree(scene, tree, {0, 0, 0});
     scene.sources.skies.push_back({SkyModel::kCieOvercast, {120.0}, SkyDiscretization::kTurtle46});
-    // A name of its own: the tests run side by side in processes of their own.
-    const std::string path = ::testing::TempDir() + "shared_meshes_tree.scene.txtpb";
+    const std::string path = testing::TempPath("tree.scene.txtpb");
     SaveSceneFile(scene, path);
     const Scene back = LoadSceneFile(path);
     ASSERT_EQ(back.nodes.size(), scene.nodes.size());
@@ -89,8 +88,8 @@ TEST(SceneFile, ReadsAndWritesTheBinaryEncodingByItsName) {
     tree.leafCount = 40;
     AddTree(scene, tree, {0, 0, 0});
     scene.sources.suns.push_back({glm::normalize(glm::dvec3(0.3, -0.4, 0.8)), {400.0, 350.0}, 0.0});
-    const std::string text = ::testing::TempDir() + "encodings_tree.scene.txtpb",
-                      binary = ::testing::TempDir() + "encodings_tree.scene.binpb";
+    const std::string text = testing::TempPath("tree.scene.txtpb"),
+                      binary = testing::TempPath("tree.scene.binpb");
     SaveSceneFile(scene, text);
     SaveSceneFile(scene, binary);
     std::ifstream in(binary, std::ios::binary);

@@ -16,6 +16,7 @@
 #include "solver/scene/geometry.h"
 #include "solver/scene/world_frames.h"
 #include "solver/util/error.h"
+#include "tests/temp_file.h"
 
 namespace leaflux {
 namespace {
@@ -51,7 +52,7 @@ std::string Text(const Scene& scene, SceneWriting writing) {
 }
 
 Scene RoundTrip(const Scene& scene, SceneWriting writing, const std::string& name) {
-    const std::string path = ::testing::TempDir() + name;
+    const std::string path = testing::TempPath(name);
     SaveSceneFile(scene, path, writing);
     return LoadSceneFile(path);
 }
@@ -328,7 +329,7 @@ structures { key: "plant" value {
 )";
 
 Scene Load(const std::string& text) {
-    const std::string path = ::testing::TempDir() + "structures.scene.txtpb";
+    const std::string path = testing::TempPath("structures.scene.txtpb");
     std::ofstream(path) << text;
     return LoadSceneFile(path);
 }

@@ -32,7 +32,7 @@ class WorldFrames {
 };
 
 // Each node with its frame in the world, parents before children (depth first from the
-// roots, each node's children in the nodes' order), the frames not kept: 20 bytes a node
+// roots, each node's children in the nodes' order), the frames not kept: 28 bytes a node
 // for the walk, where WorldFrames keeps 136. Nodes whose parent links loop or lead to no
 // node are not visited.
 void ForEachWorldFrame(const Scene& scene,
