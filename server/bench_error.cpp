@@ -134,8 +134,8 @@ std::optional<Solution> ReadCachedReference(const std::filesystem::path& path,
     for (EnergyBalance& e : solution.balance) {
         e = {next(), next(), next(), next()};
     }
-    solution.light.assign(receivers, std::vector<BandLight>(bands));
-    for (auto& receiver : solution.light) {
+    solution.light.assign(receivers, bands);
+    for (const std::span<BandLight> receiver : solution.light) {
         for (BandLight& l : receiver) {
             l.irradianceUpperWm2 = next();
             l.irradianceLowerWm2 = next();

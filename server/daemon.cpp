@@ -107,7 +107,7 @@ SolverSettings SettingsFromProto(const v1::SolverSettings& in) {
     return settings;
 }
 
-void BandsToProto(const Scene& scene, const std::vector<BandLight>& bands,
+void BandsToProto(const Scene& scene, std::span<const BandLight> bands,
                   const std::vector<int>& wanted, bool lightVectors,
                   google::protobuf::RepeatedPtrField<v1::BandLight>* out) {
     for (int b : wanted) {

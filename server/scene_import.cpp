@@ -117,7 +117,7 @@ void ReadImports(const v1::Scene& message, Scene& scene, const std::filesystem::
             node.id += import.id_offset();
             if (node.parent == kNoParent) {
                 node.parent = import.parent();
-                node.parentFromLocal = frame * node.parentFromLocal;
+                node.parentFromLocal = frame * glm::dmat4(node.parentFromLocal);
             } else {
                 node.parent += import.id_offset();
             }

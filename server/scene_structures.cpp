@@ -204,10 +204,10 @@ void ExpandPlacements(const v1::Scene& message, const MeshLibrary& meshes,
             }
             if (node.parent == kNoParent) {
                 node.parent = job.rootParent;
-                if (node.parentFromLocal == glm::dmat4(1.0)) {
+                if (node.parentFromLocal == Frame(1.0)) {
                     node.parentFromLocal = job.rootFrame;  // exact: no product with identity
                 } else {
-                    node.parentFromLocal = job.rootFrame * node.parentFromLocal;
+                    node.parentFromLocal = job.rootFrame * glm::dmat4(node.parentFromLocal);
                 }
             } else {
                 node.parent = placed(node.parent);

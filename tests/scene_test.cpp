@@ -114,7 +114,7 @@ std::vector<BadInput> BadInputs() {
         {"self parent", [](Scene& s) { s.nodes[0].parent = 1; }, ErrorCode::kCycle, "parent", 1},
         {"NaN frame", [](Scene& s) { s.nodes[0].parentFromLocal[3][0] = kNan; },
          ErrorCode::kInvalidArgument, "frame", 1},
-        {"singular frame", [](Scene& s) { s.nodes[0].parentFromLocal[2] = glm::dvec4(0.0); },
+        {"singular frame", [](Scene& s) { s.nodes[0].parentFromLocal[2] = glm::dvec3(0.0); },
          ErrorCode::kDegenerate, "frame", 1},
         {"infinite age", [](Scene& s) { s.nodes[0].age = kInf; }, ErrorCode::kInvalidArgument,
          "age", 1},
@@ -145,7 +145,7 @@ std::vector<BadInput> BadInputs() {
         {"frame collapses a leaf",
          [](Scene& s) {
              s.nodes[0].parentFromLocal = glm::dmat4(1.0);
-             s.nodes[0].parentFromLocal[1] = glm::dvec4(1e-40, 0, 0, 0);
+             s.nodes[0].parentFromLocal[1] = glm::dvec3(1e-40, 0, 0);
          },
          ErrorCode::kDegenerate, "frame", 1},
         {"duplicate organ name",
@@ -274,9 +274,9 @@ INSTANTIATE_TEST_SUITE_P(Scene, RejectsBadInput,
 TEST(Scene, WorldFromLocalComposesParentsFirst) {
     Scene scene = ValidScene();
     scene.nodes[0].parentFromLocal = glm::dmat4(1.0);
-    scene.nodes[0].parentFromLocal[3] = glm::dvec4(10, 0, 0, 1);  // plant at x = 10
-    scene.nodes[1].parentFromLocal = glm::dmat4(2.0);             // leaf scaled ×2
-    scene.nodes[1].parentFromLocal[3] = glm::dvec4(0, 1, 0, 1);
+    scene.nodes[0].parentFromLocal[3] = glm::dvec3(10, 0, 0);  // plant at x = 10
+    scene.nodes[1].parentFromLocal = glm::dmat4(2.0);          // leaf scaled ×2
+    scene.nodes[1].parentFromLocal[3] = glm::dvec3(0, 1, 0);
     const auto world = WorldFromLocal(scene);
     const glm::dvec3 p = glm::dvec3(world.at(2) * glm::dvec4(1, 0, 0, 1));
     EXPECT_EQ(p, glm::dvec3(12, 1, 0));
@@ -284,7 +284,7 @@ TEST(Scene, WorldFromLocalComposesParentsFirst) {
 
 TEST(Flatten, KeepsMillimetresFarFromTheOrigin) {
     Scene scene = ValidScene();
-    scene.nodes[0].parentFromLocal[3] = glm::dvec4(1e5, 1e5, 0, 1);
+    scene.nodes[0].parentFromLocal[3] = glm::dvec3(1e5, 1e5, 0);
     scene.environment.clear();
     scene.nodes[1].organ->mesh = Rectangle(0.001, 0.001, 1.0);
     const FlatScene flat = Flatten(scene);
@@ -356,7 +356,8 @@ TEST(SceneStore, FlattensAsTheWholeSceneAfterEachChange) {
 
     SceneChange bend;
     Node phytomer = FindNode(store.Get(), isPhytomer);
-    phytomer.parentFromLocal = glm::rotate(phytomer.parentFromLocal, 0.3, glm::dvec3(1, 0, 0));
+    phytomer.parentFromLocal =
+        glm::rotate(glm::dmat4(phytomer.parentFromLocal), 0.3, glm::dvec3(1, 0, 0));
     bend.updated.push_back(phytomer);
     Node leaf = FindNode(store.Get(), isLeaf);
     leaf.organ->mesh = Rectangle(0.2, 0.1, 0.0);
@@ -386,7 +387,7 @@ TEST(SceneStore, ChecksTheOrgansAChangeMoves) {
         FindNode(store.Get(), [](const Node& n) { return n.type == NodeType::kLeaf; });
     Node phytomer = FindNode(store.Get(), [&](const Node& n) { return n.id == leaf.parent; });
     ASSERT_FALSE(phytomer.organ.has_value());
-    phytomer.parentFromLocal = glm::scale(phytomer.parentFromLocal, glm::dvec3(1e-9));
+    phytomer.parentFromLocal = glm::scale(glm::dmat4(phytomer.parentFromLocal), glm::dvec3(1e-9));
     SceneChange shrink;
     shrink.updated.push_back(phytomer);
     try {
@@ -491,7 +492,7 @@ TEST(SceneStore, UndoRestoresTheSceneBefore) {
     SceneChange change;
     change.removed.push_back(nth(NodeType::kAxis, 3).id);
     Node bent = nth(NodeType::kPhytomer, 1);
-    bent.parentFromLocal = glm::rotate(bent.parentFromLocal, 0.2, glm::dvec3(0, 1, 0));
+    bent.parentFromLocal = glm::rotate(glm::dmat4(bent.parentFromLocal), 0.2, glm::dvec3(0, 1, 0));
     change.updated.push_back(bent);
     Node renamed = nth(NodeType::kLeaf, 0);
     renamed.name = "renamed";

@@ -63,10 +63,10 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
     // A part root's frame in the world, up its parents (the frames of every node would be
     // 136 bytes each).
     const auto worldFromRoot = [&](std::size_t i) {
-        glm::dmat4 frame = scene.nodes[i].parentFromLocal;
+        glm::dmat4 frame(scene.nodes[i].parentFromLocal);
         for (NodeId up = scene.nodes[i].parent; up != kNoParent;) {
             const Node& parent = scene.nodes[indexOf.at(up)];
-            frame = parent.parentFromLocal * frame;
+            frame = glm::dmat4(parent.parentFromLocal) * frame;
             up = parent.parent;
         }
         return frame;
@@ -78,7 +78,7 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
             walk.pop_back();
             if (scene.nodes[i].organ) visit(*scene.nodes[i].organ->mesh, instanceFromNode);
             for (std::size_t c : children[i])
-                walk.push_back({c, instanceFromNode * scene.nodes[c].parentFromLocal});
+                walk.push_back({c, instanceFromNode * glm::dmat4(scene.nodes[c].parentFromLocal)});
         }
     };
     std::array<double, AreaGrid::kCount> cells;

@@ -10,7 +10,6 @@
 #include <mutex>
 #include <numbers>
 #include <tuple>
-#include <unordered_map>
 
 #include "solver/instancing/instance_tree.h"
 #include "solver/instancing/original.h"
@@ -71,16 +70,15 @@ class InstancedSolve {
         for (std::uint32_t r = 0; r < receivers.receivers.size(); ++r) {
             const Receiver& receiver = receivers.receivers[r];
             if (receiver.kind == ReceiverKind::kOrgan) {
-                organReceiver_[receiver.node] = r;
+                organReceiver_.push_back({receiver.node, r});
                 LEAFLUX_CHECK_EQ(receiver.firstTriangle, organTriangles_);  // organs first
                 organTriangles_ += receiver.triangleCount;
             } else if (firstOther_ == kNoReceiver) {
                 firstOther_ = r;
             }
         }
-        organAreaNormals_ = OrganAreaNormals(scene, organTriangles_);
-        out_.solution.light.assign(receivers.receivers.size(),
-                                   std::vector<BandLight>(scene.bands.size()));
+        std::sort(organReceiver_.begin(), organReceiver_.end());
+        out_.solution.light.assign(receivers.receivers.size(), scene.bands.size());
         out_.solution.balance.assign(scene.bands.size(), EnergyBalance{});
         out_.solution.unsolved.assign(receivers.receivers.size(), 0);
         out_.stats.depths.assign(tree.Depth() + 1, InstancedStats::Depth{});
@@ -139,8 +137,18 @@ class InstancedSolve {
     // environment surfaces and emitters are the top's, after its organs, in order.
     std::uint32_t Global(const FlatScene& flat, std::uint32_t organs, std::uint32_t r) const {
         const Receiver& receiver = flat.receivers[r];
-        if (receiver.kind == ReceiverKind::kOrgan) return organReceiver_.at(receiver.node);
+        if (receiver.kind == ReceiverKind::kOrgan) {
+            const std::uint32_t global = OrganReceiver(receiver.node);
+            LEAFLUX_CHECK(global != kNoReceiver);
+            return global;
+        }
         return firstOther_ + (r - organs);
+    }
+    // The scene's receiver of an organ; kNoReceiver for a node that is none.
+    std::uint32_t OrganReceiver(NodeId node) const {
+        const auto at = std::lower_bound(organReceiver_.begin(), organReceiver_.end(),
+                                         std::pair<NodeId, std::uint32_t>{node, 0});
+        return at != organReceiver_.end() && at->first == node ? at->second : kNoReceiver;
     }
     // The top's receivers are all the scene's; an opened part's are its organs, then the
     // surfaces it holds.
@@ -200,12 +208,11 @@ class InstancedSolve {
     const InstancedOptions options_;  // directOnly: holdOutside off (DirectOnlyAlone)
     InstancedSolution& out_;
     const DirectionSet& directions_;
-    std::unordered_map<NodeId, std::uint32_t> organReceiver_;
+    std::vector<std::pair<NodeId, std::uint32_t>> organReceiver_;  // sorted by node
     std::uint32_t firstOther_ = kNoReceiver;  // the first environment surface or emitter
     std::uint32_t organTriangles_ = 0;        // of the receivers, the organs' first
     // A n of every organ triangle of the scene: Σ A |n · ω| scales ε at the top as it
     // scales HRC's on the flattened scene (LevelProblem::organsProjectedArea).
-    std::vector<glm::vec3> organAreaNormals_;
     // The top's surfaces as solved, each patch side that sends light an emitter, which
     // every opened instance holds (ReceiverKind::kHeld); their meshes shared.
     std::vector<Emitter> held_;
@@ -245,9 +252,9 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
     for (std::uint32_t q : part.instances) {
         const InstanceTree::Part& instance = tree_[q];
         const Node& root = scene_.nodes[instance.rootIndex];
-        const glm::dmat4 world = root.parent == kNoParent
-                                     ? root.parentFromLocal
-                                     : worldFromLocal.at(root.parent) * root.parentFromLocal;
+        const glm::dmat4 world = root.parent == kNoParent ? glm::dmat4(root.parentFromLocal)
+                                                          : worldFromLocal.at(root.parent) *
+                                                                glm::dmat4(root.parentFromLocal);
         level->worldFromClosed.push_back(world);
         middle += glm::dvec3(world * glm::dvec4(Centre(instance.boxMin, instance.boxMax), 1.0));
     }
@@ -327,13 +334,15 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     problem.sources = std::move(sources);
     problem.errorW = errorW_;
     problem.sourceCount = sourceCount_;
-    if (p == InstanceTree::kTop) {  // ε as HRC takes it
-        problem.organsProjectedArea = [this](const glm::dvec3& omega) {
-            double area = 0.0;
-            for (const glm::vec3& an : organAreaNormals_)
-                area += std::abs(glm::dot(glm::dvec3(an), omega));
-            return area;
-        };
+    if (p == InstanceTree::kTop) {  // ε as HRC takes it, while the top is solved alone
+        problem.organsProjectedArea =
+            [areaNormals = std::make_shared<std::vector<glm::vec3>>(
+                 OrganAreaNormals(scene_, organTriangles_))](const glm::dvec3& omega) {
+                double area = 0.0;
+                for (const glm::vec3& an : *areaNormals)
+                    area += std::abs(glm::dot(glm::dvec3(an), omega));
+                return area;
+            };
     }
     problem.splitSurfaces = true;  // the surfaces' light, held by the contents (Build)
     problem.holdLevel = options_.holdOutside;
@@ -342,8 +351,10 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     // Its receivers' light, where the scene has them.
     const FlatScene& flat = level.flat;
     const std::uint32_t organs = OrganCount(flat);
-    for (std::uint32_t r = 0; r < OwnReceivers(p, flat); ++r)
-        out_.solution.light[Global(flat, organs, r)] = std::move(light.solution.light[r]);
+    for (std::uint32_t r = 0; r < OwnReceivers(p, flat); ++r) {
+        const std::span<const BandLight> bands = light.solution.light[r];
+        std::copy(bands.begin(), bands.end(), out_.solution.light[Global(flat, organs, r)].begin());
+    }
     InstancedStats::Problem size;
     size.depth = tree_[p].depth;
     size.triangles = static_cast<std::int64_t>(flat.triangles.size());
@@ -555,9 +566,9 @@ void InstancedSolve::ShadowTriangles(std::uint32_t q, ClosedNode& closed) const 
     std::vector<std::uint32_t> parts = {q};
     for (std::size_t k = 0; k < parts.size(); ++k) {
         for (std::size_t i : tree_[parts[k]].nodes) {
-            const auto it = organReceiver_.find(scene_.nodes[i].id);
-            if (it == organReceiver_.end()) continue;
-            const Receiver& r = receivers_.receivers[it->second];
+            const std::uint32_t global = OrganReceiver(scene_.nodes[i].id);
+            if (global == kNoReceiver) continue;
+            const Receiver& r = receivers_.receivers[global];
             if (r.triangleCount > 0)
                 ranges.push_back({r.firstTriangle, r.firstTriangle + r.triangleCount});
         }
@@ -580,11 +591,11 @@ void InstancedSolve::ShadowTriangles(std::uint32_t q, ClosedNode& closed) const 
 
 void InstancedSolve::MarkUnsolved(std::uint32_t q, StructureLight& whole) {
     for (std::size_t i : tree_[q].nodes) {
-        const auto it = organReceiver_.find(scene_.nodes[i].id);
-        if (it == organReceiver_.end()) continue;
-        out_.solution.unsolved[it->second] = 1;
+        const std::uint32_t global = OrganReceiver(scene_.nodes[i].id);
+        if (global == kNoReceiver) continue;
+        out_.solution.unsolved[global] = 1;
         ++whole.organCount;
-        whole.areaM2 += receivers_.receivers[it->second].areaM2;
+        whole.areaM2 += receivers_.receivers[global].areaM2;
     }
     for (std::uint32_t inner : tree_[q].instances) MarkUnsolved(inner, whole);
 }

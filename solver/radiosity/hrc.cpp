@@ -139,7 +139,7 @@ class SceneSolve {
     // The clock started before the hierarchy was built: its time is the solve's.
     Solution Run(const ResourceClock& clock) {
         Solution solution;
-        solution.light.assign(flat_.receivers.size(), std::vector<BandLight>(channels_.bands));
+        solution.light.assign(flat_.receivers.size(), channels_.bands);
         solution.balance.assign(channels_.bands, EnergyBalance{});
         const int threads = CoresOf(options_.threads);
         if (hierarchy_.Root() != kNoNode) OnCores(threads, [&] { Solve(solution); });
@@ -536,7 +536,7 @@ Solution SceneSolve::RunLocal(NodeId root) {
     LEAFLUX_CHECK(refiner_ && hierarchy_.Closed().empty());
     const ResourceClock clock;
     Solution solution;
-    solution.light.assign(flat_.receivers.size(), std::vector<BandLight>(channels_.bands));
+    solution.light.assign(flat_.receivers.size(), channels_.bands);
     solution.balance.assign(channels_.bands, EnergyBalance{});
     const int threads = CoresOf(options_.threads);
     OnCores(threads, [&] {

@@ -4,6 +4,7 @@
 // leaf patch side towards the sky (its standard error reported). Reads the solve's state.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -30,7 +31,7 @@ class SolutionSink : public LightSink {
   public:
     explicit SolutionSink(Solution& solution) : solution_(solution) {}
     void Receiver(std::size_t receiver, const std::vector<BandLight>& light) override {
-        solution_.light[receiver] = light;
+        std::ranges::copy(light, solution_.light[receiver].begin());
     }
 
   private:

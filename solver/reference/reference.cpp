@@ -484,7 +484,7 @@ Solution SolveGroup(const Scene& scene, const FlatScene& flat, const RayScene& r
 
     PathTracer tracer(scene, flat, rays, options);
     Solution solution;
-    solution.light.assign(receivers, std::vector<BandLight>(bands));
+    solution.light.assign(receivers, bands);
     // Per receiver and band: incident − absorbed − escaped of each replicate, for the
     // standard error of the balance; the sums are made in receiver order afterwards.
     std::vector<std::array<Estimate, kBandGroup>> incident(receivers), absorbed(receivers),
@@ -581,15 +581,13 @@ Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScen
     if (bands <= kBandGroup) return SolveGroup(scene, flat, rays, options);
     const ResourceClock clock;
     Solution solution;
-    solution.light.assign(flat.receivers.size(), {});
+    solution.light.assign(flat.receivers.size(), bands);
     for (int first = 0; first < bands; first += kBandGroup) {
         std::vector<int> group;
         for (int b = first; b < std::min(bands, first + kBandGroup); ++b) group.push_back(b);
         const Solution part = SolveGroup(WithBands(scene, group), flat, rays, options);
-        for (std::size_t r = 0; r < part.light.size(); ++r) {
-            solution.light[r].insert(solution.light[r].end(), part.light[r].begin(),
-                                     part.light[r].end());
-        }
+        for (std::size_t r = 0; r < part.light.size(); ++r)
+            std::ranges::copy(part.light[r], solution.light[r].begin() + first);
         solution.balance.insert(solution.balance.end(), part.balance.begin(), part.balance.end());
         solution.stats.rays += part.stats.rays;
         solution.stats.threads = part.stats.threads;

@@ -33,7 +33,7 @@ std::vector<StructureLight> AggregateStructures(const Scene& scene, const FlatSc
     std::unordered_map<NodeId, StructureLight> sums;
     // Adds `organs` organs of area a and light `light` (area means, summed powers) to s.
     const auto add = [&](StructureLight& s, int organs, double a,
-                         const std::vector<BandLight>& light) {
+                         std::span<const BandLight> light) {
         if (s.bands.empty()) {
             s.bands.assign(bands, BandLight{});
             for (BandLight& b : s.bands)

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -113,8 +114,55 @@ struct StructureLight {
     std::vector<BandLight> bands;
 };
 
+// The light of every receiver in every band, in one block: table[receiver][band]. A vector
+// a receiver cost 40 bytes more each, 10 MB on a plantation.
+class LightTable {
+  public:
+    template <class Light>
+    class Rows {  // iterates receivers, each a span of its bands
+      public:
+        Rows(Light* at, std::size_t bands) : at_(at), bands_(bands) {}
+        std::span<Light> operator*() const { return {at_, bands_}; }
+        Rows& operator++() {
+            at_ += bands_;
+            return *this;
+        }
+        bool operator==(const Rows& other) const { return at_ == other.at_; }
+
+      private:
+        Light* at_;
+        std::size_t bands_;
+    };
+
+    LightTable() = default;
+    LightTable(std::size_t receivers, std::size_t bands) { assign(receivers, bands); }
+    // Every receiver's every band unlit.
+    void assign(std::size_t receivers, std::size_t bands) {
+        receivers_ = receivers;
+        bands_ = bands;
+        light_.assign(receivers * bands, BandLight{});
+    }
+
+    std::size_t size() const { return receivers_; }  // receivers
+    bool empty() const { return receivers_ == 0; }
+    std::size_t Bands() const { return bands_; }
+    std::span<BandLight> operator[](std::size_t r) { return {light_.data() + r * bands_, bands_}; }
+    std::span<const BandLight> operator[](std::size_t r) const {
+        return {light_.data() + r * bands_, bands_};
+    }
+    std::span<const BandLight> front() const { return (*this)[0]; }
+    Rows<BandLight> begin() { return {light_.data(), bands_}; }
+    Rows<BandLight> end() { return {light_.data() + light_.size(), bands_}; }
+    Rows<const BandLight> begin() const { return {light_.data(), bands_}; }
+    Rows<const BandLight> end() const { return {light_.data() + light_.size(), bands_}; }
+
+  private:
+    std::size_t receivers_ = 0, bands_ = 0;
+    std::vector<BandLight> light_;
+};
+
 struct Solution {
-    std::vector<std::vector<BandLight>> light;  // [receiver][band]
+    LightTable light;
     // Structures solved as a whole, their leaves not one by one (the instanced solver
     // stopped opening there: InstancedOptions::maxDepth, openUntil): the light of each as
     // one, its irradiances NaN (not solved); their organs are `unsolved` (1 by receiver)

@@ -56,7 +56,7 @@ Solution ReadLeafCsv(const std::string& path, const Scene& scene, const FlatScen
         bands.emplace(scene.bands[b].name, b);
 
     Solution solution;
-    solution.light.assign(flat.receivers.size(), std::vector<BandLight>(scene.bands.size()));
+    solution.light.assign(flat.receivers.size(), scene.bands.size());
     std::vector<std::uint8_t> seen(flat.receivers.size() * scene.bands.size(), 0);
     for (int number = 2; std::getline(in, line); ++number) {
         if (line.empty()) continue;

@@ -219,7 +219,7 @@ void ValidateNode(const Scene& scene, const Node& node) {
         throw InputError(ErrorCode::kInvalidArgument, "nodes.id", "0 is not a valid id");
     if (!InvertibleFrame(node.parentFromLocal)) {
         for (int c = 0; c < 4; ++c) {
-            for (int r = 0; r < 4; ++r) {
+            for (int r = 0; r < 3; ++r) {
                 if (!std::isfinite(node.parentFromLocal[c][r]))
                     throw InputError(ErrorCode::kInvalidArgument, "frame", "is not finite",
                                      node.id);

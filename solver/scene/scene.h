@@ -9,13 +9,13 @@
 
 #include <cstdint>
 #include <glm/glm.hpp>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
+#include "solver/scene/attributes.h"
 #include "solver/sources/sources.h"
 
 namespace leaflux {
@@ -84,14 +84,18 @@ struct Organ {
     std::string opticsId;
 };
 
+// An affine frame: three rows of four, the fourth row (0 0 0 1) implied; 96 bytes where a
+// glm::dmat4 takes 128, a tenth of a node. Composed as glm::dmat4(a) * glm::dmat4(b).
+using Frame = glm::dmat4x3;
+
 struct Node {
     NodeId id = 0;
     NodeId parent = kNoParent;
     NodeType type = NodeType::kOther;
-    std::string name;                 // empty: "node<id>"
-    glm::dmat4 parentFromLocal{1.0};  // affine; z along the structure's main axis
-    double age = 0.0;                 // physiological age
-    std::map<std::string, double> attributes;
+    std::string name;            // empty: "node<id>"
+    Frame parentFromLocal{1.0};  // z along the structure's main axis
+    double age = 0.0;            // physiological age
+    Attributes attributes;
     std::optional<Organ> organ;
 };
 

@@ -140,7 +140,7 @@ SceneStore::Plan SceneStore::Check(const SceneChange& change) const {
                                                : plan.touched.count(node.parent)
                                                    ? plan.touched.at(node.parent).worldFromLocal
                                                    : kept_.at(node.parent).worldFromLocal;
-            plan.touched[*it].worldFromLocal = worldFromParent * node.parentFromLocal;
+            plan.touched[*it].worldFromLocal = worldFromParent * glm::dmat4(node.parentFromLocal);
         }
     }
     // Organs: checked and placed again unless mesh and world frame are as they were.

@@ -63,13 +63,14 @@ void ForEachWorldFrame(const Scene& scene,
     }
     std::vector<std::pair<std::uint32_t, glm::dmat4>> stack;
     for (auto r = roots.rbegin(); r != roots.rend(); ++r)
-        stack.push_back({*r, scene.nodes[*r].parentFromLocal});
+        stack.push_back({*r, glm::dmat4(scene.nodes[*r].parentFromLocal)});
     while (!stack.empty()) {
         const auto [i, frame] = stack.back();
         stack.pop_back();
         visit(scene.nodes[i], frame);
         for (std::uint32_t k = first[i + 1]; k-- > first[i];)
-            stack.push_back({children[k], frame * scene.nodes[children[k]].parentFromLocal});
+            stack.push_back(
+                {children[k], frame * glm::dmat4(scene.nodes[children[k]].parentFromLocal)});
     }
 }
 

@@ -23,6 +23,7 @@
 #include "server/executor.h"
 #include "server/transport.h"
 #include "solver/generate/generator.h"
+#include "solver/util/memory.h"
 
 namespace leaflux {
 namespace {
@@ -101,6 +102,7 @@ struct Row {
 
 int main(int argc, char** argv) {
     using namespace leaflux;
+    MapLargeBlocksApart();
     // Every request is logged at info level: SPDLOG_LEVEL=info shows them, debug the phases
     // of each cycle and of the solver.
     spdlog::set_level(spdlog::level::warn);
