@@ -12,7 +12,7 @@ on the stiff scenes of tests/hrc_accuracy_test.cpp (`report:accuracy`).
 Usage: bench_report.py BUILD_DIR OUT_DIR [--only error,problems,scaling,phase,phase-db,phase-spread,growth,import,accuracy,stability,daemon,
                        daemon-accuracy,soak,rays,render,summary]
                       [--scenes a,b]
-                      [--scaling-solvers hrc,mc,instanced,instanced-tau]
+                      [--scaling-solvers hrc,mc,instanced,instanced-compact,instanced-tau]
        bench_report.py --tables-only [--only ...]   # rewrite from examples/report/, run nothing
 The growth part reads the demo's out/demo/ (run scripts/demo.sh first).
 """
@@ -628,7 +628,7 @@ def main():
     parser.add_argument("--only", default="error,problems,scaling,phase,phase-db,phase-spread,growth,import,accuracy,stability,daemon,daemon-accuracy,soak,rays,render",
                         help="parts to run (default: all)")
     parser.add_argument("--scenes", default=",".join(SCENES), help="error part: scenes (default: all)")
-    parser.add_argument("--scaling-solvers", default="hrc,mc,instanced,instanced-tau",
+    parser.add_argument("--scaling-solvers", default="hrc,mc,instanced,instanced-compact,instanced-tau",
                         help="solvers the scaling run measures; the others' rows are kept from OUT_DIR")
     parser.add_argument("--demo", default=os.path.join(ROOT, "out", "demo"),
                         help="growth part: the output of scripts/demo.sh (default: out/demo)")

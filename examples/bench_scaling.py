@@ -6,12 +6,14 @@ memory and working memory (the peak while solving less the memory once the scene
 loaded) per series and solver (paper §3.5: HRC's n·log n time and super-linear memory are
 the baseline instantiation must beat). The instanced solver runs at HRC's ε from a phase-function
 database in OUT_DIR that an earlier run filled (a run that had to compute a function is
-run again), with shadows by geometry (`instanced`, the default) and by transmittance
-(`instanced-tau`, which never holds the whole scene's triangles).
+run again), with shadows by geometry (`instanced`, the default), by geometry in the ray
+engine's compact hierarchy (`instanced-compact`) and by transmittance (`instanced-tau`,
+which never holds the whole scene's triangles).
 
 Usage: bench_scaling.py BUILD_DIR OUT_DIR [--leaves 1000,10000,100000,1000000]
                         [--trees 1,4,16,64,233] [--epsilon 1e-5] [--samples 256]
-                        [--solvers hrc,mc,instanced,instanced-tau] [--tau-leaves 250000]
+                        [--solvers hrc,mc,instanced,instanced-compact,instanced-tau]
+                        [--tau-leaves 250000]
 Writes OUT_DIR/scaling.csv, OUT_DIR/fits.csv and OUT_DIR/scaling.png and prints the table.
 A run that fails (out of memory) is a row with its exit status and no figures.
 """
@@ -36,6 +38,8 @@ SOLVERS = {
     "mc": lambda args, db: (args.samples, ["--solver", "mc", "--samples", args.samples]),
     "instanced": lambda args, db: (args.epsilon, ["--solver", "instanced", "--epsilon", args.epsilon,
                                                   "--phase-db", db]),
+    "instanced-compact": lambda args, db: (args.epsilon, ["--solver", "instanced", "--epsilon", args.epsilon,
+                                                          "--phase-db", db, "--shadows", "geometry-compact"]),
     "instanced-tau": lambda args, db: (args.epsilon, ["--solver", "instanced", "--epsilon", args.epsilon,
                                                       "--phase-db", db, "--shadows", "transmittance"]),
 }
@@ -166,7 +170,7 @@ def main():
         return
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.6))
     for series, style in (("one tree", "-"), ("trees", "--")):
-        for solver, marker, colour in zip(SOLVERS, ("s", "o", "^", "v"), ("C0", "C1", "C2", "C3")):
+        for solver, marker, colour in zip(SOLVERS, ("s", "o", "^", "D", "v"), ("C0", "C1", "C2", "C4", "C3")):
             points = [r for r in rows if r["series"] == series and r["solver"] == solver and r["status"] == "ok"]
             if not points:
                 continue

@@ -31,7 +31,7 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command);
 // Whether direct light meets the whole scene's triangles (then the scene is flattened
 // whole).
 inline bool ShadowsByGeometry(const InstancedCommand& command) {
-    return command.shadows == "geometry";
+    return command.shadows != "transmittance";
 }
 
 // Solves with the instanced solver and prints its statistics; `shadows` the flat scene's

@@ -144,9 +144,9 @@ TEST(RayScene, WrapsAroundAPeriodicTile) {
 
 TEST(RayScene, TrianglesPlacedStraightInTraceAsTheFlatScenes) {
     // A tree of placed frames over a ground: the triangles written straight into the engine
-    // from the scene (the instanced solver's shadows) against the flat scene's, ray by
-    // ray, the organs alone too (OccludedByFirst), and the receivers without triangles
-    // against Flatten's.
+    // from the scene (the instanced solver's shadows), in the default hierarchy and in the
+    // compact one, against the flat scene's, ray by ray, the organs alone too
+    // (OccludedByFirst), and the receivers without triangles against Flatten's.
     Scene scene = OneBandScene({{"leaf", Leaf(0.1, 0.05)}, {"stem", Opaque(0.2)}});
     TreeParameters tree;
     tree.leafCount = 200;
@@ -179,6 +179,7 @@ TEST(RayScene, TrianglesPlacedStraightInTraceAsTheFlatScenes) {
 
     const RayScene whole(flat, std::nullopt);
     const std::unique_ptr<RayScene> placed = SceneRays(scene, receivers);
+    const std::unique_ptr<RayScene> compact = SceneRays(scene, receivers, true);
     Random random(7);
     int hits = 0, blocked = 0, byGround = 0;  // by the organs, and by the ground or wall alone
     for (int i = 0; i < 4000; ++i) {
@@ -208,6 +209,16 @@ TEST(RayScene, TrianglesPlacedStraightInTraceAsTheFlatScenes) {
         if (first.fate == RayFate::kHit) {
             EXPECT_EQ(hit.triangle, first.triangle) << "ray " << i;
             EXPECT_EQ(hit.distance, first.distance) << "ray " << i;
+        }
+        // The compact hierarchy holds the same triangles (--shadows geometry-compact).
+        EXPECT_EQ(compact->Occluded(start, direction), occluded) << "ray " << i;
+        EXPECT_EQ(compact->OccludedByFirst(start, direction, INFINITY, organTriangles), byOrgans)
+            << "ray " << i;
+        const RayHit packed = compact->Trace(start, direction);
+        EXPECT_EQ(packed.fate, hit.fate) << "ray " << i;
+        if (hit.fate == RayFate::kHit) {
+            EXPECT_EQ(packed.triangle, hit.triangle) << "ray " << i;
+            EXPECT_EQ(packed.distance, hit.distance) << "ray " << i;
         }
     }
     EXPECT_GT(byGround, 100);  // the ground and the wall are in the engine

@@ -130,17 +130,20 @@ RayScene::RayScene(const FlatScene& flat, std::optional<PeriodicDomain> periodic
 }
 
 RayScene::RayScene(const FlatScene& frame, std::uint32_t triangles,
-                   const std::function<void(float*)>& place, std::shared_ptr<RayDevice> device)
+                   const std::function<void(float*)>& place, bool compact,
+                   std::shared_ptr<RayDevice> device)
     : flat_(frame), device_(std::move(device)) {
-    BuildMesh(triangles, place);
+    BuildMesh(triangles, place, compact);
     BuildTop();
 }
 
-void RayScene::BuildMesh(std::size_t count, const std::function<void(float*)>& place) {
+void RayScene::BuildMesh(std::size_t count, const std::function<void(float*)>& place,
+                         bool compact) {
     SetFlushToZero();
     RTCDevice rtc = device_->Get();
     mesh_ = rtcNewScene(rtc);
     rtcSetSceneBuildQuality(mesh_, RTC_BUILD_QUALITY_HIGH);
+    if (compact) rtcSetSceneFlags(mesh_, RTC_SCENE_FLAG_COMPACT);
     if (count > 0) {
         RTCGeometry geometry = rtcNewGeometry(rtc, RTC_GEOMETRY_TYPE_TRIANGLE);
         place(static_cast<float*>(rtcSetNewGeometryBuffer(
@@ -357,11 +360,11 @@ bool RayScene::Occluded(const RayStart& start, const glm::dvec3& direction,
     return false;
 }
 
-std::unique_ptr<RayScene> SceneRays(const Scene& scene, const FlatScene& receivers) {
+std::unique_ptr<RayScene> SceneRays(const Scene& scene, const FlatScene& receivers, bool compact) {
     std::uint32_t triangles = 0;
     for (const Receiver& receiver : receivers.receivers) triangles += receiver.triangleCount;
-    return std::make_unique<RayScene>(receivers, triangles,
-                                      [&](float* xyz) { PlaceTriangles(scene, receivers, xyz); });
+    return std::make_unique<RayScene>(
+        receivers, triangles, [&](float* xyz) { PlaceTriangles(scene, receivers, xyz); }, compact);
 }
 
 }  // namespace leaflux
