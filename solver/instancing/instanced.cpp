@@ -211,8 +211,6 @@ class InstancedSolve {
     std::vector<std::pair<NodeId, std::uint32_t>> organReceiver_;  // sorted by node
     std::uint32_t firstOther_ = kNoReceiver;  // the first environment surface or emitter
     std::uint32_t organTriangles_ = 0;        // of the receivers, the organs' first
-    // A n of every organ triangle of the scene: Σ A |n · ω| scales ε at the top as it
-    // scales HRC's on the flattened scene (LevelProblem::organsProjectedArea).
     // The top's surfaces as solved, each patch side that sends light an emitter, which
     // every opened instance holds (ReceiverKind::kHeld); their meshes shared.
     std::vector<Emitter> held_;
@@ -334,7 +332,9 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     problem.sources = std::move(sources);
     problem.errorW = errorW_;
     problem.sourceCount = sourceCount_;
-    if (p == InstanceTree::kTop) {  // ε as HRC takes it, while the top is solved alone
+    // A n of every organ triangle of the scene, held while the top is solved: Σ A |n · ω|
+    // scales ε at the top as it scales HRC's on the flattened scene.
+    if (p == InstanceTree::kTop) {
         problem.organsProjectedArea =
             [areaNormals = std::make_shared<std::vector<glm::vec3>>(
                  OrganAreaNormals(scene_, organTriangles_))](const glm::dvec3& omega) {
