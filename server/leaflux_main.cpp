@@ -38,7 +38,6 @@
 #include "solver/results/export.h"
 #include "solver/solve.h"
 #include "solver/util/error.h"
-#include "solver/util/memory.h"
 
 namespace leaflux {
 namespace {
@@ -59,7 +58,6 @@ void WriteSecret(const std::string& path, const std::string& text) {
 
 int main(int argc, char** argv) {
     using namespace leaflux;
-    MapLargeBlocksApart();
     CLI::App app{
         "leaflux: light on plants by hierarchical radiosity, with a Monte Carlo reference"};
     app.require_subcommand(1);

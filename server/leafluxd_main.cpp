@@ -23,7 +23,6 @@
 #include "server/executor.h"
 #include "server/transport.h"
 #include "solver/instancing/phase_db.h"
-#include "solver/util/memory.h"
 
 namespace {
 std::atomic<int> signals{0};
@@ -34,7 +33,6 @@ void OnSignal(int) {
 
 int main(int argc, char** argv) {
     using namespace leaflux;
-    MapLargeBlocksApart();
     CLI::App app{"leafluxd: the leaflux lighting daemon (ZeroMQ + protobuf, leaflux.v1)"};
     app.option_defaults()->always_capture_default();  // --help shows every default
     std::string bind = "tcp://127.0.0.1:5555", level = "info", logFile;

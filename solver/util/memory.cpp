@@ -42,8 +42,6 @@ bool ResetPeakRss() {
     return static_cast<bool>(clearRefs);
 }
 
-void MapLargeBlocksApart() { mallopt(M_MMAP_THRESHOLD, 128 * 1024); }
-
 double CpuSeconds() {
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);

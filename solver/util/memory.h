@@ -15,11 +15,6 @@ std::int64_t ResidentBytes();
 // peak of several runs in turn (Linux /proc/self/clear_refs). False when the kernel does
 // not allow it: the peak then stays the process's.
 bool ResetPeakRss();
-// Has malloc map every block of 128 kB and more apart and unmap it when freed. glibc's
-// default threshold rises with each such block freed, so that later ones come from the
-// heap and, freed, stay there as holes: a plantation's instanced solve peaked 17 MiB higher.
-// Called first thing by the programs that solve.
-void MapLargeBlocksApart();
 // CPU time used by the process so far, all threads (seconds).
 double CpuSeconds();
 

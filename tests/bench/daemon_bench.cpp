@@ -23,7 +23,6 @@
 #include "server/executor.h"
 #include "server/transport.h"
 #include "solver/generate/generator.h"
-#include "solver/util/memory.h"
 
 namespace leaflux {
 namespace {
@@ -102,7 +101,6 @@ struct Row {
 
 int main(int argc, char** argv) {
     using namespace leaflux;
-    MapLargeBlocksApart();
     // Every request is logged at info level: SPDLOG_LEVEL=info shows them, debug the phases
     // of each cycle and of the solver.
     spdlog::set_level(spdlog::level::warn);
