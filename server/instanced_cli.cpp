@@ -32,7 +32,7 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
                     "instanced: what direct light from the suns and sky meets: geometry (every "
                     "triangle of the scene, exact shadows, the scene's triangles in memory), "
                     "geometry-compact (the same in a compact ray-engine hierarchy: about 30 % "
-                    "less memory for the triangles, 10 to 35 % slower) or transmittance (the "
+                    "less memory for the triangles, up to 45 % slower) or transmittance (the "
                     "closed instances' τ, the paper's; memory follows the depth of instances)")
         ->capture_default_str()
         ->check(CLI::IsMember({"geometry", "geometry-compact", "transmittance"}));

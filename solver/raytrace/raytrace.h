@@ -77,7 +77,7 @@ class RayScene {
     // `frame` (origin, bounds; its triangles unused): the whole scene's triangles without a
     // flat scene of them (PlaceTriangles). Not periodic. `compact`: Embree's compact
     // hierarchy, whose leaves index the triangles instead of copying them (on a plantation's
-    // 620,000 triangles, 57 MB instead of 79; its solve 10 to 35 % slower).
+    // 620,000 triangles, 57 MB instead of 79; its solve up to 45 % slower).
     RayScene(const FlatScene& frame, std::uint32_t triangles,
              const std::function<void(float*)>& place, bool compact = false,
              std::shared_ptr<RayDevice> device = RayDevice::Shared());
