@@ -33,6 +33,10 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command);
 inline bool ShadowsByGeometry(const InstancedCommand& command) {
     return command.shadows != "transmittance";
 }
+// Whether those triangles are in the ray engine's compact hierarchy (SceneRays).
+inline bool CompactShadows(const InstancedCommand& command) {
+    return command.shadows == "geometry-compact";
+}
 
 // Solves with the instanced solver and prints its statistics; `shadows` the flat scene's
 // rays when ShadowsByGeometry, else null and `flat` the receivers alone.

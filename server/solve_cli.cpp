@@ -129,8 +129,8 @@ std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
     } else {
         solved->receivers = ReceiversOf(scene);
         if (ShadowsByGeometry(command.instanced))
-            solved->shadows = SceneRays(scene, solved->receivers,
-                                        command.instanced.shadows == "geometry-compact");
+            solved->shadows =
+                SceneRays(scene, solved->receivers, CompactShadows(command.instanced));
     }
     const FlatScene& flat = solved->Flat();
     SolverSettings settings;
