@@ -90,12 +90,14 @@ void WriteCachedReference(const std::filesystem::path& path, const Solution& sol
         for (const EnergyBalance& e : solution.balance) {
             WriteDoubles(out, {e.incidentW, e.absorbedW, e.escapedW, e.stderrW});
         }
-        for (const auto& receiver : solution.light) {
-            for (const BandLight& l : receiver) {
+        for (std::size_t r = 0; r < solution.light.size(); ++r) {
+            const std::span<const BandError> errors = solution.ErrorOf(r);
+            for (std::size_t b = 0; b < solution.light.Bands(); ++b) {
+                const BandLight& l = solution.light[r][b];
+                const BandError e = errors.empty() ? BandError{-1.0, -1.0, -1.0} : errors[b];
                 WriteDoubles(out, {l.irradianceUpperWm2, l.irradianceLowerWm2, l.absorbedW,
                                    l.radianceIntegral, l.radianceMoment.x, l.radianceMoment.y,
-                                   l.radianceMoment.z, l.stderrUpperWm2, l.stderrLowerWm2,
-                                   l.stderrAbsorbedW});
+                                   l.radianceMoment.z, e.upperWm2, e.lowerWm2, e.absorbedW});
             }
         }
         if (!out) throw InputError(ErrorCode::kIo, partial.string(), "cannot write");
@@ -135,16 +137,16 @@ std::optional<Solution> ReadCachedReference(const std::filesystem::path& path,
         e = {next(), next(), next(), next()};
     }
     solution.light.assign(receivers, bands);
-    for (const std::span<BandLight> receiver : solution.light) {
-        for (BandLight& l : receiver) {
+    solution.error.assign(receivers, bands);  // a reference is Monte Carlo's: it has them
+    for (std::size_t r = 0; r < receivers; ++r) {
+        for (std::size_t b = 0; b < bands; ++b) {
+            BandLight& l = solution.light[r][b];
             l.irradianceUpperWm2 = next();
             l.irradianceLowerWm2 = next();
             l.absorbedW = next();
             l.radianceIntegral = next();
             l.radianceMoment = {next(), next(), next()};
-            l.stderrUpperWm2 = next();
-            l.stderrLowerWm2 = next();
-            l.stderrAbsorbedW = next();
+            solution.error[r][b] = {next(), next(), next()};
         }
     }
     if (!in || in.peek() != std::char_traits<char>::eof()) {

@@ -107,9 +107,10 @@ SolverSettings SettingsFromProto(const v1::SolverSettings& in) {
     return settings;
 }
 
+// `errors`: the bands' standard errors, or none (-1 in the reply).
 void BandsToProto(const Scene& scene, std::span<const BandLight> bands,
-                  const std::vector<int>& wanted, bool lightVectors,
-                  google::protobuf::RepeatedPtrField<v1::BandLight>* out) {
+                  std::span<const BandError> errors, const std::vector<int>& wanted,
+                  bool lightVectors, google::protobuf::RepeatedPtrField<v1::BandLight>* out) {
     for (int b : wanted) {
         const BandLight& light = bands[b];
         v1::BandLight* band = out->Add();
@@ -123,8 +124,8 @@ void BandsToProto(const Scene& scene, std::span<const BandLight> bands,
             band->mutable_light_vector()->set_y(v.y);
             band->mutable_light_vector()->set_z(v.z);
         }
-        band->set_stderr_upper_wm2(light.stderrUpperWm2);
-        band->set_stderr_lower_wm2(light.stderrLowerWm2);
+        band->set_stderr_upper_wm2(errors.empty() ? -1.0 : errors[b].upperWm2);
+        band->set_stderr_lower_wm2(errors.empty() ? -1.0 : errors[b].lowerWm2);
         if (const std::optional<double> photons = PhotonUmolPerJ(scene.bands[b])) {
             band->set_photon_irradiance_upper_umol_m2_s(*photons * light.irradianceUpperWm2);
             band->set_photon_irradiance_lower_umol_m2_s(*photons * light.irradianceLowerWm2);
@@ -317,7 +318,8 @@ Session::Solved Session::Solve(const v1::OutputRequest& outputs) const {
             organ->set_node(receiver.node);
             organ->set_name(receiver.name);
             organ->set_area_m2(receiver.areaM2);
-            BandsToProto(solved, solution.light[r], wanted, lightVectors, organ->mutable_bands());
+            BandsToProto(solved, solution.light[r], solution.ErrorOf(r), wanted, lightVectors,
+                         organ->mutable_bands());
         }
     }
     if (outputs.structures()) {
@@ -328,7 +330,8 @@ Session::Solved Session::Solve(const v1::OutputRequest& outputs) const {
             structure->set_type(TypeToProto(s.type));
             structure->set_organs(s.organCount);
             structure->set_area_m2(s.areaM2);
-            BandsToProto(solved, s.bands, wanted, lightVectors, structure->mutable_bands());
+            BandsToProto(solved, s.bands, s.errors, wanted, lightVectors,
+                         structure->mutable_bands());
         }
     }
     v1::SolveStatistics* stats = result.mutable_statistics();

@@ -38,9 +38,10 @@ struct HandMadeCase {
         Solution solution;
         solution.balance.resize(1);
         solution.light.assign(flat.receivers.size(), 1);
+        if (stderrWm2 >= 0.0) solution.error.assign(flat.receivers.size(), 1);
         for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
             BandLight& light = solution.light[r][0];
-            light.stderrUpperWm2 = light.stderrLowerWm2 = stderrWm2;
+            if (stderrWm2 >= 0.0) solution.error[r][0] = {stderrWm2, stderrWm2, 0.0};
             if (flat.receivers[r].kind != ReceiverKind::kOrgan) {
                 light.irradianceUpperWm2 = 1e6;  // not a leaf: must not count
                 continue;

@@ -188,7 +188,8 @@ TEST(FilterT, LayersAreLitOneHalfQuarterAndGroundEighth) {
     for (int r = 0; r < 4; ++r) {
         const BandLight& light = solution.light[r][0];
         const double lit = (light.irradianceUpperWm2 + light.irradianceLowerWm2) / 1000.0;
-        const double error = std::hypot(light.stderrUpperWm2, light.stderrLowerWm2) / 1000.0;
+        const BandError& stderrs = solution.error[r][0];
+        const double error = std::hypot(stderrs.upperWm2, stderrs.lowerWm2) / 1000.0;
         EXPECT_NEAR(lit, expected[r], 4.6 * error + 1e-12) << prepared.Flat().receivers[r].name;
     }
 }

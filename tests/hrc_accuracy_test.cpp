@@ -81,8 +81,9 @@ double SideError(const Solution& reference, const Solution& other, std::size_t o
         const BandLight &a = reference.light[r][0], &b = other.light[r][0];
         sum += std::pow(a.irradianceUpperWm2 - b.irradianceUpperWm2, 2) +
                std::pow(a.irradianceLowerWm2 - b.irradianceLowerWm2, 2);
-        sum -= variance(a.stderrUpperWm2) + variance(a.stderrLowerWm2) +
-               variance(b.stderrUpperWm2) + variance(b.stderrLowerWm2);
+        const BandError ae = reference.ErrorAt(r, 0), be = other.ErrorAt(r, 0);
+        sum -= variance(ae.upperWm2) + variance(ae.lowerWm2) + variance(be.upperWm2) +
+               variance(be.lowerWm2);
         mean += a.irradianceUpperWm2 + a.irradianceLowerWm2;
     }
     return std::sqrt(std::max(sum, 0.0) / (2.0 * organs)) / (mean / (2.0 * organs));
@@ -251,8 +252,9 @@ TEST(HrcAccuracy, ALampBarLightsEachLeafSideAsRaysFind) {
         const BandLight &a = reference.light[r][0], &b = hrc.light[r][0];
         sums[0][0] += a.irradianceUpperWm2, sums[0][1] += a.irradianceLowerWm2;
         sums[1][0] += b.irradianceUpperWm2, sums[1][1] += b.irradianceLowerWm2;
-        variance[0] += a.stderrUpperWm2 * a.stderrUpperWm2;
-        variance[1] += a.stderrLowerWm2 * a.stderrLowerWm2;
+        const BandError& error = reference.error[r][0];
+        variance[0] += error.upperWm2 * error.upperWm2;
+        variance[1] += error.lowerWm2 * error.lowerWm2;
     }
     const double side = SideError(reference, hrc, leaves, true);
     std::printf(
@@ -296,8 +298,9 @@ TEST(HrcAccuracy, AnIsotropicFieldLightsEverySideAlikeFromEveryDirection) {
         double worst = 0.0, largest = 0.0, sum = 0.0, squares = 0.0;
         for (int r = 0; r < leaves; ++r) {
             const BandLight& b = s.light[r][0];
-            for (const auto& [e, error] : {std::pair{b.irradianceUpperWm2, b.stderrUpperWm2},
-                                           std::pair{b.irradianceLowerWm2, b.stderrLowerWm2}}) {
+            const BandError be = s.ErrorAt(r, 0);
+            for (const auto& [e, error] : {std::pair{b.irradianceUpperWm2, be.upperWm2},
+                                           std::pair{b.irradianceLowerWm2, be.lowerWm2}}) {
                 worst = std::max(worst, std::abs(e / 100.0 - 1.0));
                 sum += e, squares += e * e;
                 // Monte Carlo: each side within its noise (5.5 σ: 2e-5 over 600 sides; the

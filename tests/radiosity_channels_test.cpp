@@ -88,8 +88,9 @@ TEST(ReferenceChannels, SixteenBandsEachAgreeWithTheBandSolvedAlone) {
             const BandLight& y = one.light[r][0];
             SCOPED_TRACE("receiver " + std::to_string(r) + ", band " + std::to_string(b));
             EXPECT_GT(y.irradianceUpperWm2, 0.0);
-            const double upper = std::hypot(x.stderrUpperWm2, y.stderrUpperWm2);
-            const double lower = std::hypot(x.stderrLowerWm2, y.stderrLowerWm2);
+            const BandError &xe = all.error[r][b], &ye = one.error[r][0];
+            const double upper = std::hypot(xe.upperWm2, ye.upperWm2);
+            const double lower = std::hypot(xe.lowerWm2, ye.lowerWm2);
             EXPECT_NEAR(x.irradianceUpperWm2, y.irradianceUpperWm2,
                         5.0 * upper + 1e-9 * y.irradianceUpperWm2);
             EXPECT_NEAR(x.irradianceLowerWm2, y.irradianceLowerWm2,

@@ -24,11 +24,18 @@ constexpr double kRounding = 1e-9;
 struct Solved {
     FlatScene flat;
     Solution solution;
-    const BandLight& Of(const std::string& name, int band = 0) const {
+    std::size_t Receiver(const std::string& name) const {
         for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
-            if (flat.receivers[r].name == name) return solution.light[r][band];
+            if (flat.receivers[r].name == name) return r;
         }
         throw std::runtime_error("no receiver " + name);
+    }
+    const BandLight& Of(const std::string& name, int band = 0) const {
+        return solution.light[Receiver(name)][band];
+    }
+    // Its standard errors.
+    const BandError& ErrorOf(const std::string& name, int band = 0) const {
+        return solution.error[Receiver(name)][band];
     }
 };
 
@@ -64,9 +71,10 @@ TEST(SinglePlate, UnderSunGetsSinOfElevationOnTop) {
     scene.sources.suns.push_back(SunAt(30, 120, 1000));
     const Solved solved = Solve(scene, 256);
     const BandLight& light = solved.Of("plate");
-    ExpectWithin(light.irradianceUpperWm2, 500.0, light.stderrUpperWm2);
+    const BandError& error = solved.ErrorOf("plate");
+    ExpectWithin(light.irradianceUpperWm2, 500.0, error.upperWm2);
     EXPECT_EQ(light.irradianceLowerWm2, 0.0);
-    ExpectWithin(light.absorbedW, 500.0, light.stderrAbsorbedW);
+    ExpectWithin(light.absorbedW, 500.0, error.absorbedW);
     // One collimated beam: the light vector is the unit vector towards the sun.
     const glm::dvec3 v = light.LightVector();
     EXPECT_NEAR(glm::length(v), 1.0, 1e-12);
@@ -80,7 +88,8 @@ TEST(SinglePlate, UnderUniformSkyGetsPiL) {
     scene.sources.skies.push_back({SkyModel::kUniform, {kPi * radiance}});
     const Solved solved = Solve(scene, 16384);
     const BandLight& light = solved.Of("plate");
-    ExpectWithin(light.irradianceUpperWm2, kPi * radiance, light.stderrUpperWm2);
+    const BandError& error = solved.ErrorOf("plate");
+    ExpectWithin(light.irradianceUpperWm2, kPi * radiance, error.upperWm2);
     EXPECT_EQ(light.irradianceLowerWm2, 0.0);
     // Light from the whole upper hemisphere: the light vector points up, |v| = 1/2.
     EXPECT_NEAR(light.LightVector().z, 0.5, 0.02);
@@ -93,8 +102,9 @@ TEST(SinglePlate, UnderDiscretisedSkyKeepsTheHorizontalIrradiance) {
         scene.sources.skies.push_back({SkyModel::kCieOvercast, {300.0}, discretization});
         const Solved solved = Solve(scene, 16384);
         const BandLight& light = solved.Of("plate");
+        const BandError& error = solved.ErrorOf("plate");
         // The cones are normalised to give exactly the horizontal irradiance.
-        ExpectWithin(light.irradianceUpperWm2, 300.0, light.stderrUpperWm2);
+        ExpectWithin(light.irradianceUpperWm2, 300.0, error.upperWm2);
     }
 }
 
@@ -143,9 +153,10 @@ TEST_P(ViewFactor, BlackReceiverMatchesHowell) {
     scene.sources.emitters.push_back({"lamp", c.emitter, {exitance}, ""});
     const Solved solved = Solve(scene, 65536);
     const BandLight& light = solved.Of("receiver");
+    const BandError& stderrs = solved.ErrorOf("receiver");
     // The receiver's upper side faces away from the emitter in every case.
     const double e = light.irradianceLowerWm2 + light.irradianceUpperWm2;
-    const double error = std::hypot(light.stderrLowerWm2, light.stderrUpperWm2);
+    const double error = std::hypot(stderrs.lowerWm2, stderrs.upperWm2);
     ExpectWithin(e, exitance * c.viewFactorTimesAreaRatio, error,
                  // The table's 6 digits, and the shapes' approximation.
                  exitance * (5e-7 + c.geometryError * c.viewFactorTimesAreaRatio));
@@ -160,7 +171,8 @@ TEST(Furnace, RadiosityIsEmittanceOverOneMinusRho) {
         const Solved solved = Solve(Furnace(rho, exitance), 16384);
         for (int f = 0; f < 6; ++f) {
             const BandLight& light = solved.Of("face" + std::to_string(f));
-            ExpectWithin(light.irradianceUpperWm2, exitance / (1.0 - rho), light.stderrUpperWm2);
+            const BandError& error = solved.ErrorOf("face" + std::to_string(f));
+            ExpectWithin(light.irradianceUpperWm2, exitance / (1.0 - rho), error.upperWm2);
             // Outside the box is dark, but for rays that leave a face at a shared edge and,
             // in single-precision traversal, graze into the box: a few 1e-8 of the inside.
             EXPECT_NEAR(light.irradianceLowerWm2, 0.0, 1e-6 * exitance / (1.0 - rho));

@@ -102,16 +102,16 @@ void ExpectCloseToReference(const PreparedScene& prepared, const Solution& solut
     for (const auto& light : reference.light) {
         largest = std::max({largest, light[0].irradianceUpperWm2, light[0].irradianceLowerWm2});
     }
-    auto noise = [](double e) { return e > 0.0 ? e : 0.0; };
     for (std::size_t r = 0; r < reference.light.size(); ++r) {
         const BandLight& want = reference.light[r][0];
         const BandLight& got = solution.light[r][0];
+        const BandError wantError = reference.ErrorAt(r, 0), gotError = solution.ErrorAt(r, 0);
         const std::string& name = prepared.Flat().receivers[r].name;
         for (const auto& [value, expected, error] :
              {std::tuple{got.irradianceUpperWm2, want.irradianceUpperWm2,
-                         std::hypot(want.stderrUpperWm2, noise(got.stderrUpperWm2))},
+                         std::hypot(wantError.upperWm2, gotError.upperWm2)},
               std::tuple{got.irradianceLowerWm2, want.irradianceLowerWm2,
-                         std::hypot(want.stderrLowerWm2, noise(got.stderrLowerWm2))}}) {
+                         std::hypot(wantError.lowerWm2, gotError.lowerWm2)}}) {
             if (expected < 0.01 * largest) continue;
             EXPECT_NEAR(value, expected, 0.05 * expected + 4.6 * error) << name;
         }
@@ -285,7 +285,8 @@ TEST_P(Stability, LampOneMillimetreBelowALeaf) {
         ExpectBalanced(solution, Kind());
         return;
     }
-    EXPECT_NEAR(leaf.irradianceLowerWm2, lampWm2, 0.003 * lampWm2 + 4.6 * leaf.stderrLowerWm2);
+    EXPECT_NEAR(leaf.irradianceLowerWm2, lampWm2,
+                0.003 * lampWm2 + 4.6 * solution.error[0][0].lowerWm2);
     ExpectBalanced(solution, Kind());
     ExpectCloseToReference(Prepared(), solution);
 }
@@ -365,9 +366,9 @@ TEST_P(Stability, LeavesOfOneMillimetreAndTenMetres) {
     const double tolerance = 0.01 * kSunWm2;  // the 2e-6 unseen, and HRC's link error
     EXPECT_NEAR(small.irradianceUpperWm2, kSunWm2, tolerance);
     EXPECT_NEAR(small.irradianceLowerWm2, 0.3 * kSunWm2,
-                tolerance + 4.6 * std::max(small.stderrLowerWm2, 0.0));
+                tolerance + 4.6 * solution.ErrorAt(0, 0).lowerWm2);
     EXPECT_NEAR(large.irradianceUpperWm2, kSunWm2,
-                tolerance + 4.6 * std::max(large.stderrUpperWm2, 0.0));
+                tolerance + 4.6 * solution.ErrorAt(1, 0).upperWm2);
 }
 
 // A hundred kilometres from the origin: a lone leaf still gets E·sin h exactly, and two
@@ -411,8 +412,9 @@ TEST_P(Stability, OneLeaf) {
     const BandLight& light = solution.light[0][0];
     // Monte Carlo within its noise; HRC's 46 sky cones sum the cosine of a horizontal
     // leaf to 1 % (their directions are the cones' centres).
-    const double tolerance = Kind() != SolverKind::kMonteCarlo ? 1e-6 * kSunWm2 + 0.01 * 100.0
-                                                               : 4.6 * light.stderrUpperWm2;
+    const double tolerance = Kind() != SolverKind::kMonteCarlo
+                                 ? 1e-6 * kSunWm2 + 0.01 * 100.0
+                                 : 4.6 * solution.error[0][0].upperWm2;
     EXPECT_NEAR(light.irradianceUpperWm2, 600.0, tolerance);
     EXPECT_EQ(light.irradianceLowerWm2, 0.0);
     EXPECT_NEAR(light.absorbedW, 0.85 * 600.0 * 0.02, 0.85 * 0.02 * tolerance);

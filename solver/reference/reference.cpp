@@ -485,6 +485,7 @@ Solution SolveGroup(const Scene& scene, const FlatScene& flat, const RayScene& r
     PathTracer tracer(scene, flat, rays, options);
     Solution solution;
     solution.light.assign(receivers, bands);
+    solution.error.assign(receivers, bands);
     // Per receiver and band: incident − absorbed − escaped of each replicate, for the
     // standard error of the balance; the sums are made in receiver order afterwards.
     std::vector<std::array<Estimate, kBandGroup>> incident(receivers), absorbed(receivers),
@@ -532,9 +533,7 @@ Solution SolveGroup(const Scene& scene, const FlatScene& flat, const RayScene& r
                 light.irradianceUpperWm2 = up.mean;
                 light.irradianceLowerWm2 = low.mean;
                 light.absorbedW = abs.mean;
-                light.stderrUpperWm2 = up.error;
-                light.stderrLowerWm2 = low.error;
-                light.stderrAbsorbedW = abs.error;
+                solution.error[r][b] = {up.error, low.error, abs.error};
                 incident[r][b] = Combine(in);
                 absorbed[r][b] = abs;
                 escaped[r][b] = Combine(out);
@@ -582,12 +581,15 @@ Solution SolveReference(const Scene& scene, const FlatScene& flat, const RayScen
     const ResourceClock clock;
     Solution solution;
     solution.light.assign(flat.receivers.size(), bands);
+    solution.error.assign(flat.receivers.size(), bands);
     for (int first = 0; first < bands; first += kBandGroup) {
         std::vector<int> group;
         for (int b = first; b < std::min(bands, first + kBandGroup); ++b) group.push_back(b);
         const Solution part = SolveGroup(WithBands(scene, group), flat, rays, options);
-        for (std::size_t r = 0; r < part.light.size(); ++r)
+        for (std::size_t r = 0; r < part.light.size(); ++r) {
             std::ranges::copy(part.light[r], solution.light[r].begin() + first);
+            std::ranges::copy(part.error[r], solution.error[r].begin() + first);
+        }
         solution.balance.insert(solution.balance.end(), part.balance.begin(), part.balance.end());
         solution.stats.rays += part.stats.rays;
         solution.stats.threads = part.stats.threads;

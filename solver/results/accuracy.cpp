@@ -76,11 +76,10 @@ std::vector<BandAccuracy> CompareLeaves(const Scene& scene, const FlatScene& fla
     for (std::size_t b = 0; b < scene.bands.size(); ++b) {
         std::vector<Pair> pairs;
         for (std::size_t r : leaves) {
-            const BandLight& truth = reference.light[r][b];
-            const bool error = truth.stderrUpperWm2 >= 0.0 && truth.stderrLowerWm2 >= 0.0;
+            const std::span<const BandError> error = reference.ErrorOf(r);
             pairs.push_back(
-                {BothSides(truth), BothSides(value.light[r][b]),
-                 error ? std::hypot(truth.stderrUpperWm2, truth.stderrLowerWm2) : -1.0});
+                {BothSides(reference.light[r][b]), BothSides(value.light[r][b]),
+                 error.empty() ? -1.0 : std::hypot(error[b].upperWm2, error[b].lowerWm2)});
         }
         bands.push_back(Accuracy(pairs));
     }
@@ -97,10 +96,10 @@ std::vector<BandAccuracy> CompareWholeStructures(const Scene& scene, const FlatS
         std::vector<Pair> pairs;
         for (const StructureLight& whole : value.wholeStructures) {
             const StructureLight& expected = *truth.at(whole.node);
-            const BandLight& light = expected.bands[b];
             pairs.push_back(
-                {light.absorbedW / expected.areaM2, whole.bands[b].absorbedW / whole.areaM2,
-                 light.stderrAbsorbedW >= 0.0 ? light.stderrAbsorbedW / expected.areaM2 : -1.0});
+                {expected.bands[b].absorbedW / expected.areaM2,
+                 whole.bands[b].absorbedW / whole.areaM2,
+                 expected.errors.empty() ? -1.0 : expected.errors[b].absorbedW / expected.areaM2});
         }
         bands.push_back(Accuracy(pairs));
     }

@@ -25,15 +25,17 @@ namespace {
 
 // `photons`: the band's µmol per J (solver/scene/light_units.h); none leaves the photon
 // columns empty.
-void WriteLight(std::ostream& out, const BandLight& light, std::optional<double> photons) {
+// `error`: its standard errors, if the solver gave them.
+void WriteLight(std::ostream& out, const BandLight& light, const BandError* error,
+                std::optional<double> photons) {
     const glm::dvec3 v = light.LightVector();
     // NaN: not solved (a structure solved whole), an empty cell.
     const auto irradiance = [](double value) { return std::isnan(value) ? "" : Number(value); };
     out << irradiance(light.irradianceUpperWm2) << ',' << irradiance(light.irradianceLowerWm2)
         << ',' << Number(light.absorbedW) << ',' << Number(v.x) << ',' << Number(v.y) << ','
         << Number(v.z) << ',';
-    if (light.stderrUpperWm2 >= 0.0) {
-        out << Number(light.stderrUpperWm2) << ',' << Number(light.stderrLowerWm2);
+    if (error != nullptr) {
+        out << Number(error->upperWm2) << ',' << Number(error->lowerWm2);
     } else {
         out << ',';
     }
@@ -64,7 +66,9 @@ void WriteLeafCsv(std::ostream& out, const Scene& scene, const FlatScene& flat,
         for (std::size_t b = 0; b < scene.bands.size(); ++b) {
             out << CsvQuoted(flat.receivers[r].name) << ',' << CsvQuoted(scene.bands[b].name) << ','
                 << Number(flat.receivers[r].areaM2) << ',';
-            WriteLight(out, solution.light[r][b], PhotonUmolPerJ(scene.bands[b]));
+            const std::span<const BandError> error = solution.ErrorOf(r);
+            WriteLight(out, solution.light[r][b], error.empty() ? nullptr : &error[b],
+                       PhotonUmolPerJ(scene.bands[b]));
         }
     }
 }
@@ -77,7 +81,8 @@ void WriteStructureCsv(std::ostream& out, const Scene& scene,
             out << s.node << ',' << CsvQuoted(s.name) << ',' << NodeTypeName(s.type) << ','
                 << s.organCount << ',' << CsvQuoted(scene.bands[b].name) << ',' << Number(s.areaM2)
                 << ',';
-            WriteLight(out, s.bands[b], PhotonUmolPerJ(scene.bands[b]));
+            WriteLight(out, s.bands[b], s.errors.empty() ? nullptr : &s.errors[b],
+                       PhotonUmolPerJ(scene.bands[b]));
         }
     }
 }

@@ -31,13 +31,14 @@ std::vector<StructureLight> AggregateStructures(const Scene& scene, const FlatSc
 
     // Sums first: area-weighted irradiances and squared errors; normalised at the end.
     std::unordered_map<NodeId, StructureLight> sums;
-    // Adds `organs` organs of area a and light `light` (area means, summed powers) to s.
-    const auto add = [&](StructureLight& s, int organs, double a,
-                         std::span<const BandLight> light) {
+    // Adds `organs` organs of area a and light `light` (area means, summed powers) to s,
+    // with their standard errors `error` when the solver gave them (squared, summed).
+    const bool errors = !solution.error.empty();
+    const auto add = [&](StructureLight& s, int organs, double a, std::span<const BandLight> light,
+                         std::span<const BandError> error) {
         if (s.bands.empty()) {
             s.bands.assign(bands, BandLight{});
-            for (BandLight& b : s.bands)
-                b.stderrUpperWm2 = b.stderrLowerWm2 = b.stderrAbsorbedW = 0.0;
+            if (errors) s.errors.assign(bands, BandError{});
         }
         s.organCount += organs;
         s.areaM2 += a;
@@ -49,13 +50,12 @@ std::vector<StructureLight> AggregateStructures(const Scene& scene, const FlatSc
             sum.absorbedW += leaf.absorbedW;
             sum.radianceIntegral += a * leaf.radianceIntegral;
             sum.radianceMoment += a * leaf.radianceMoment;
-            const bool hasError = leaf.stderrUpperWm2 >= 0.0;
-            sum.stderrUpperWm2 =
-                hasError ? sum.stderrUpperWm2 + std::pow(a * leaf.stderrUpperWm2, 2) : -1.0;
-            sum.stderrLowerWm2 =
-                hasError ? sum.stderrLowerWm2 + std::pow(a * leaf.stderrLowerWm2, 2) : -1.0;
-            sum.stderrAbsorbedW =
-                hasError ? sum.stderrAbsorbedW + std::pow(leaf.stderrAbsorbedW, 2) : -1.0;
+            if (!error.empty()) {
+                BandError& e = s.errors[b];
+                e.upperWm2 += std::pow(a * error[b].upperWm2, 2);
+                e.lowerWm2 += std::pow(a * error[b].lowerWm2, 2);
+                e.absorbedW += std::pow(error[b].absorbedW, 2);
+            }
         }
     };
     for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
@@ -63,12 +63,12 @@ std::vector<StructureLight> AggregateStructures(const Scene& scene, const FlatSc
         if (receiver.kind != ReceiverKind::kOrgan) continue;
         if (!solution.unsolved.empty() && solution.unsolved[r]) continue;
         for (NodeId at = receiver.node; at != kNoParent; at = byId.at(at)->parent)
-            add(sums[at], 1, receiver.areaM2, solution.light[r]);
+            add(sums[at], 1, receiver.areaM2, solution.light[r], solution.ErrorOf(r));
     }
     // Those solved whole, into themselves and the structures above them.
     for (const StructureLight& whole : solution.wholeStructures) {
         for (NodeId at = whole.node; at != kNoParent; at = byId.at(at)->parent)
-            add(sums[at], whole.organCount, whole.areaM2, whole.bands);
+            add(sums[at], whole.organCount, whole.areaM2, whole.bands, whole.errors);
     }
     std::vector<StructureLight> result;
     for (const Node& node : scene.nodes) {
@@ -83,11 +83,11 @@ std::vector<StructureLight> AggregateStructures(const Scene& scene, const FlatSc
             b.irradianceLowerWm2 /= s.areaM2;
             b.radianceIntegral /= s.areaM2;
             b.radianceMoment /= s.areaM2;
-            if (b.stderrUpperWm2 >= 0.0) {
-                b.stderrUpperWm2 = std::sqrt(b.stderrUpperWm2) / s.areaM2;
-                b.stderrLowerWm2 = std::sqrt(b.stderrLowerWm2) / s.areaM2;
-                b.stderrAbsorbedW = std::sqrt(b.stderrAbsorbedW);
-            }
+        }
+        for (BandError& e : s.errors) {
+            e.upperWm2 = std::sqrt(e.upperWm2) / s.areaM2;
+            e.lowerWm2 = std::sqrt(e.lowerWm2) / s.areaM2;
+            e.absorbedW = std::sqrt(e.absorbedW);
         }
         result.push_back(std::move(s));
     }

@@ -33,7 +33,8 @@ Run Measure(const PreparedScene& prepared, int samples, double sunIrradiance) {
         const BandLight& nir = solution.light[r][0];
         const double e = nir.irradianceUpperWm2 + nir.irradianceLowerWm2;
         if (e < 0.05 * sunIrradiance) continue;
-        relative.push_back(std::hypot(nir.stderrUpperWm2, nir.stderrLowerWm2) / e);
+        const BandError& error = solution.error[r][0];
+        relative.push_back(std::hypot(error.upperWm2, error.lowerWm2) / e);
     }
     std::nth_element(relative.begin(), relative.begin() + relative.size() / 2, relative.end());
     return {samples,
