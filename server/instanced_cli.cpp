@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <utility>
 
 #include "server/policy_proto.h"
 #include "solver/instancing/phase_db.h"
@@ -85,8 +86,7 @@ Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene*
                               : command.outputLevel == "axis" ? NodeType::kAxis
                                                               : NodeType::kPhytomer;
     }
-    const InstancedSolution solved =
-        SolveInstanced(scene, flat, shadows, policy, database, options);
+    InstancedSolution solved = SolveInstanced(scene, flat, shadows, policy, database, options);
     const InstancedStats& stats = solved.stats;
     std::printf("instances by depth (opened):");
     for (std::size_t d = 1; d < stats.depths.size(); ++d)
@@ -106,7 +106,7 @@ Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene*
             out << p.depth << ',' << p.triangles << ',' << p.closed << ',' << p.elements << ','
                 << p.links << ',' << p.seconds << '\n';
     }
-    return solved.solution;
+    return std::move(solved.solution);  // a copy was a second light table at the peak
 }
 
 }  // namespace leaflux
