@@ -4,12 +4,15 @@
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <unordered_set>
 
 #include "server/cli_checks.h"
 #include "server/progress.h"
@@ -66,6 +69,7 @@ std::string ReferenceKey(const Scene& scene, const ReferenceOptions& options) {
     key.Add(options.samplesPerReceiver);
     key.Add(options.replicates);
     key.Add(options.seed);
+    for (std::uint32_t r : options.only) key.Add(r);  // a sample's reference is its own
     return key.Hex();
 }
 
@@ -305,11 +309,14 @@ void PrintTable(const std::string& scene, const std::vector<Row>& rows) {
     }
 }
 
+// `within`: the sample the reference was solved for, or none (every leaf).
 std::vector<Row> RowsOf(const Run& run, const Scene& scene, const FlatScene& flat,
-                        const Solution& reference, const Solution& solution) {
+                        const Solution& reference, const Solution& solution,
+                        const std::unordered_set<NodeId>* within) {
     const std::vector<BandAccuracy> accuracy =
-        solution.wholeStructures.empty() ? CompareLeaves(scene, flat, reference, solution)
-                                         : CompareWholeStructures(scene, flat, reference, solution);
+        solution.wholeStructures.empty()
+            ? CompareLeaves(scene, flat, reference, solution, within)
+            : CompareWholeStructures(scene, flat, reference, solution, within);
     std::vector<Row> rows;
     for (std::size_t b = 0; b < scene.bands.size(); ++b) {
         rows.push_back({run.solver, run.setting, scene.bands[b].name, solution.stats, accuracy[b],
@@ -349,15 +356,40 @@ int RunErrorBench(const ErrorBenchOptions& options) {
     const std::string& name = options.name;
     PreparedScene prepared(scene);
     const FlatScene& flat = prepared.Flat();
+    // A sample of the plants (samplePlants), evenly through the scene's by id: the
+    // reference is solved for their organs alone and every error taken over their leaves.
+    std::optional<std::unordered_set<NodeId>> sample;
+    SolverSettings referenceSettings;
+    if (options.samplePlants > 0) {
+        std::vector<NodeId> plants;
+        for (const Node& node : scene.nodes)
+            if (node.type == NodeType::kPlant) plants.push_back(node.id);
+        std::sort(plants.begin(), plants.end());
+        if (plants.size() < static_cast<std::size_t>(options.samplePlants)) {
+            throw InputError(ErrorCode::kInvalidArgument, "--sample-plants",
+                             "the scene has " + std::to_string(plants.size()) +
+                                 " plants, fewer than " + std::to_string(options.samplePlants));
+        }
+        std::vector<NodeId> sampled;
+        for (int k = 0; k < options.samplePlants; ++k)
+            sampled.push_back(plants[(2 * k + 1) * plants.size() / (2 * options.samplePlants)]);
+        sample = NodesUnder(scene, sampled);
+        for (std::uint32_t r = 0; r < flat.receivers.size(); ++r) {
+            const Receiver& receiver = flat.receivers[r];
+            if (receiver.kind == ReceiverKind::kOrgan && sample->count(receiver.node))
+                referenceSettings.monteCarlo.only.push_back(r);
+        }
+    }
+    const std::unordered_set<NodeId>* within = sample ? &*sample : nullptr;
     int leaves = 0;
-    for (const Node& node : scene.nodes) leaves += node.type == NodeType::kLeaf;
+    for (const Node& node : scene.nodes)
+        leaves += node.type == NodeType::kLeaf && (!within || within->count(node.id));
     if (!ResetPeakRss()) {
         spdlog::warn(
             "the kernel does not let the peak memory be reset: each run's peak is the "
             "process's so far");
     }
 
-    SolverSettings referenceSettings;
     referenceSettings.kind = SolverKind::kMonteCarlo;
     referenceSettings.monteCarlo.samplesPerReceiver = options.referenceSamples;
     referenceSettings.monteCarlo.seed = options.referenceSeed;
@@ -393,7 +425,11 @@ int RunErrorBench(const ErrorBenchOptions& options) {
     // The reference against itself: its own error is its standard error (the floor).
     std::vector<Row> rows =
         RowsOf({"mc", "reference samples=" + std::to_string(options.referenceSamples), {}}, scene,
-               flat, *reference, *reference);
+               flat, *reference, *reference, within);
+    // A reference of a sample balances no closed part of the scene: what its organs scatter
+    // is absorbed and escapes through organs it did not solve.
+    if (within != nullptr)
+        for (Row& row : rows) row.balancePct = std::nan("");
     PhaseDatabase originals(PhaseDatabaseOptions{});  // the instanced runs'
     for (Run run : Runs(options)) {
         ResetPeakRss();
@@ -403,7 +439,7 @@ int RunErrorBench(const ErrorBenchOptions& options) {
         if (run.solver == "mc") run.settings.monteCarlo.progress = ProgressBar(label);
         const Solution solution = Solve(prepared, run.settings);
         spdlog::info("{} {}: {:.2f} s", run.solver, run.setting, solution.stats.wallSeconds);
-        for (Row& row : RowsOf(run, scene, flat, *reference, solution)) rows.push_back(row);
+        for (Row& row : RowsOf(run, scene, flat, *reference, solution, within)) rows.push_back(row);
     }
     WriteCsv(options.csv, name, leaves, rows);
     PrintTable(name, rows);

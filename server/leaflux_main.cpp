@@ -112,6 +112,13 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(2, 1 << 26));
     errorApp->add_option("--reference-seed", errorBench.referenceSeed, "Reference: random seed");
     errorApp
+        ->add_option("--sample-plants", errorBench.samplePlants,
+                     "Reference solved for the organs of this many plants alone, spread evenly "
+                     "through the scene's, and every error taken over their leaves (0: every "
+                     "leaf); the solvers still solve the whole scene")
+        ->transform(WholeNumber())
+        ->check(CLI::Range(0, 1 << 20));
+    errorApp
         ->add_option("--mc-samples", errorBench.monteCarloSamples,
                      "Monte Carlo runs: paths per receiver of each")
         ->delimiter(',')

@@ -2,7 +2,7 @@
 # `leaflux bench error` as users run it: a small canopy, the reference solved once and
 # then read from the cache, a damaged cache file solved again, the CSV and plot written,
 # a missing scene refused with its name, an --out or --cache that cannot be written refused
-# before the reference is solved.
+# before the reference is solved, a reference on a sample of plants.
 # Usage: bench_error_cli.sh BUILD_DIR
 set -euo pipefail
 leaflux=$1/server/leaflux
@@ -55,5 +55,21 @@ grep -q -- "--cache $out/a_file/reference-.*: cannot be written" "$out/unwritabl
     fail "an unwritable --cache is not named: $(cat "$out/unwritable.log")"
 grep -q "solving the reference" "$out/unwritable.log" &&
     fail "the reference was solved before --cache was checked"
+# A sample of a plantation's plants: the reference and the errors over their leaves only,
+# its balance not given (it closes over no part of the scene); more plants than the scene
+# has, refused with the option's name.
+"$leaflux" generate --leaves 30 --seed 2 --rows 2 --columns 2 --trees 4 --sky-cones turtle46 \
+    --out "$out/trees.scene.txtpb" > /dev/null
+"$leaflux" bench error --scene "$out/trees.scene.txtpb" --out "$out/error" --cache "$out/cache" \
+    --reference-samples 256 --mc-samples 16 --no-hrc --no-direct --sample-plants 2 --no-plot \
+    > "$out/sample.log" 2>&1 || fail "a sample of plants failed: $(cat "$out/sample.log")"
+grep -q "trees: 60 leaves" "$out/sample.log" || fail "the sample should count 2 plants' 60 leaves"
+grep -q "^trees,60,mc,reference samples=256,PAR,.*,nan$" "$out/error/trees.csv" ||
+    fail "the sample's reference should give no balance: $(cat "$out/error/trees.csv")"
+status=0
+"$leaflux" bench error --scene "$out/trees.scene.txtpb" --out "$out/error" --cache "$out/cache" \
+    --sample-plants 5 --no-plot > "$out/toomany.log" 2>&1 || status=$?
+test $status -ne 0 && grep -q -- "--sample-plants" "$out/toomany.log" ||
+    fail "more plants than the scene has should be refused: $(cat "$out/toomany.log")"
 echo "leaflux bench error: reference cached and reused, damaged cache solved again, CSV written," \
-     "unwritable --out and --cache refused first"
+     "unwritable --out and --cache refused first, a sample of plants compared on their leaves"

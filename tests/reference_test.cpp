@@ -184,5 +184,40 @@ TEST(Furnace, RadiosityIsEmittanceOverOneMinusRho) {
     }
 }
 
+// ReferenceOptions::only: the receivers asked are solved as in the whole solve, path for path
+// (each receiver's paths have their own random streams), and the others are left dark.
+TEST(ReferenceOnly, SolvesTheReceiversAskedAsTheWholeSolveDoes) {
+    Scene scene = OneBandScene({{"leaf", Leaf(0.3, 0.2)}});
+    for (int i = 0; i < 4; ++i) {
+        scene.nodes.push_back(OrganNode(i + 1, "plate" + std::to_string(i),
+                                        Rectangle(1.0 + 0.3 * i, 1, 1.5 - 0.5 * i), "leaf"));
+    }
+    scene.sources.suns.push_back(SunAt(50, 30, 1000));
+    scene.sources.skies.push_back({SkyModel::kUniform, {100.0}});
+    scene.Validate();
+    const FlatScene flat = Flatten(scene);
+    const RayScene rays(flat, std::nullopt);
+    ReferenceOptions options;
+    options.samplesPerReceiver = 512;
+    options.replicates = kReplicates;
+    const Solution whole = SolveReference(scene, flat, rays, options);
+    options.only = {1, 3};
+    const Solution part = SolveReference(scene, flat, rays, options);
+    for (std::uint32_t r = 0; r < flat.receivers.size(); ++r) {
+        SCOPED_TRACE(flat.receivers[r].name);
+        const BandLight &a = whole.light[r][0], &b = part.light[r][0];
+        if (r == 1 || r == 3) {
+            EXPECT_GT(a.irradianceUpperWm2, 0.0);
+            EXPECT_EQ(b.irradianceUpperWm2, a.irradianceUpperWm2);
+            EXPECT_EQ(b.irradianceLowerWm2, a.irradianceLowerWm2);
+            EXPECT_EQ(b.absorbedW, a.absorbedW);
+            EXPECT_EQ(part.error[r][0].upperWm2, whole.error[r][0].upperWm2);
+        } else {
+            EXPECT_EQ(b.irradianceUpperWm2, 0.0);
+            EXPECT_EQ(b.absorbedW, 0.0);
+        }
+    }
+}
+
 }  // namespace
 }  // namespace leaflux

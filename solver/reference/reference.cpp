@@ -496,9 +496,13 @@ Solution SolveGroup(const Scene& scene, const FlatScene& flat, const RayScene& r
     int reported = 0;
 
     const int threads = CoresOf(options.threads);
+    const auto solved =
+        options.only.empty() ? receivers : static_cast<std::uint32_t>(options.only.size());
     OnCores(threads, [&] {
-        tbb::parallel_for(std::uint32_t{0}, receivers, [&](std::uint32_t r) {
+        tbb::parallel_for(std::uint32_t{0}, solved, [&](std::uint32_t i) {
             SetFlushToZero();
+            const std::uint32_t r = options.only.empty() ? i : options.only[i];
+            LEAFLUX_CHECK(r < receivers);
             const Receiver& receiver = flat.receivers[r];
             const SideOptics& optics = tracer.Optics(r);
             std::int64_t receiverRays = 0;
@@ -542,11 +546,11 @@ Solution SolveGroup(const Scene& scene, const FlatScene& flat, const RayScene& r
             rayCount += receiverRays;
             const std::uint32_t finished = ++done;
             if (options.progress) {
-                const int percent = static_cast<int>(100.0 * finished / receivers);
+                const int percent = static_cast<int>(100.0 * finished / solved);
                 std::lock_guard lock(progressMutex);
                 if (percent > reported) {
                     reported = percent;
-                    options.progress(finished / static_cast<double>(receivers));
+                    options.progress(finished / static_cast<double>(solved));
                 }
             }
         });

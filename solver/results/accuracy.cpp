@@ -10,10 +10,12 @@
 namespace leaflux {
 namespace {
 
-std::vector<std::size_t> LeafReceivers(const Scene& scene, const FlatScene& flat) {
+std::vector<std::size_t> LeafReceivers(const Scene& scene, const FlatScene& flat,
+                                       const std::unordered_set<NodeId>* within) {
     std::unordered_set<NodeId> leaves;
     for (const Node& node : scene.nodes) {
-        if (node.type == NodeType::kLeaf) leaves.insert(node.id);
+        if (node.type == NodeType::kLeaf && (within == nullptr || within->count(node.id)))
+            leaves.insert(node.id);
     }
     std::vector<std::size_t> receivers;
     for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
@@ -67,11 +69,29 @@ BandAccuracy Accuracy(const std::vector<Pair>& pairs) {
 
 }  // namespace
 
+std::unordered_set<NodeId> NodesUnder(const Scene& scene, const std::vector<NodeId>& roots) {
+    std::unordered_map<NodeId, std::vector<NodeId>> children;
+    for (const Node& node : scene.nodes) {
+        if (node.parent != kNoParent) children[node.parent].push_back(node.id);
+    }
+    std::unordered_set<NodeId> under;
+    std::vector<NodeId> stack(roots.begin(), roots.end());
+    while (!stack.empty()) {
+        const NodeId id = stack.back();
+        stack.pop_back();
+        if (!under.insert(id).second) continue;
+        if (const auto it = children.find(id); it != children.end())
+            stack.insert(stack.end(), it->second.begin(), it->second.end());
+    }
+    return under;
+}
+
 std::vector<BandAccuracy> CompareLeaves(const Scene& scene, const FlatScene& flat,
-                                        const Solution& reference, const Solution& value) {
+                                        const Solution& reference, const Solution& value,
+                                        const std::unordered_set<NodeId>* within) {
     LEAFLUX_CHECK_EQ(reference.light.size(), flat.receivers.size());
     LEAFLUX_CHECK_EQ(value.light.size(), flat.receivers.size());
-    const std::vector<std::size_t> leaves = LeafReceivers(scene, flat);
+    const std::vector<std::size_t> leaves = LeafReceivers(scene, flat, within);
     std::vector<BandAccuracy> bands;
     for (std::size_t b = 0; b < scene.bands.size(); ++b) {
         std::vector<Pair> pairs;
@@ -87,7 +107,8 @@ std::vector<BandAccuracy> CompareLeaves(const Scene& scene, const FlatScene& fla
 }
 
 std::vector<BandAccuracy> CompareWholeStructures(const Scene& scene, const FlatScene& flat,
-                                                 const Solution& reference, const Solution& value) {
+                                                 const Solution& reference, const Solution& value,
+                                                 const std::unordered_set<NodeId>* within) {
     std::unordered_map<NodeId, const StructureLight*> truth;
     const std::vector<StructureLight> structures = AggregateStructures(scene, flat, reference);
     for (const StructureLight& s : structures) truth.emplace(s.node, &s);
@@ -95,6 +116,7 @@ std::vector<BandAccuracy> CompareWholeStructures(const Scene& scene, const FlatS
     for (std::size_t b = 0; b < scene.bands.size(); ++b) {
         std::vector<Pair> pairs;
         for (const StructureLight& whole : value.wholeStructures) {
+            if (within != nullptr && !within->count(whole.node)) continue;
             const StructureLight& expected = *truth.at(whole.node);
             pairs.push_back(
                 {expected.bands[b].absorbedW / expected.areaM2,

@@ -2,6 +2,7 @@
 // against run time (Soler 2003, Fig. 14), per band, over the leaves.
 #pragma once
 
+#include <unordered_set>
 #include <vector>
 
 #include "solver/results/light.h"
@@ -28,13 +29,21 @@ struct BandAccuracy {
 };
 
 // One entry per band of the scene. Both solutions must come from `flat`; a band without a
-// lit leaf (an empty or dark scene) gets zeros.
+// lit leaf (an empty or dark scene) gets zeros. `within`, when given: only the leaves under
+// these nodes (themselves included) count, those a reference was solved for
+// (ReferenceOptions::only), e.g. a sample of a plantation's trees.
 std::vector<BandAccuracy> CompareLeaves(const Scene& scene, const FlatScene& flat,
-                                        const Solution& reference, const Solution& value);
+                                        const Solution& reference, const Solution& value,
+                                        const std::unordered_set<NodeId>* within = nullptr);
 // The same over the structures `value` solved whole (Solution::wholeStructures), on their
 // absorbed power per organ area (W/m²) against the reference's over the same organs;
-// `leaves` counts those structures.
-std::vector<BandAccuracy> CompareWholeStructures(const Scene& scene, const FlatScene& flat,
-                                                 const Solution& reference, const Solution& value);
+// `leaves` counts those structures (under `within`, when given).
+std::vector<BandAccuracy> CompareWholeStructures(
+    const Scene& scene, const FlatScene& flat, const Solution& reference, const Solution& value,
+    const std::unordered_set<NodeId>* within = nullptr);
+
+// The nodes under any of `roots` (themselves included): ReferenceOptions::only's receivers
+// and CompareLeaves' `within` for a sample of structures.
+std::unordered_set<NodeId> NodesUnder(const Scene& scene, const std::vector<NodeId>& roots);
 
 }  // namespace leaflux
