@@ -32,9 +32,9 @@ struct ReferenceOptions {
     // Direct light only: light straight from the suns, the sky and the lamps; what leaves
     // and surfaces scatter is dropped (and shows as missing in the energy balance).
     bool directOnly = false;
-    // The receivers to solve, in increasing order (empty: every one); the others are left
-    // dark, with zero error, and out of the energy balance. A plantation's reference on a
-    // sample of its trees takes minutes where all of it would take hours.
+    // The receivers to solve (empty: every one); the others are left dark, with zero error,
+    // and out of the energy balance. A plantation's reference on a sample of its trees takes
+    // minutes where all of it would take hours.
     std::vector<std::uint32_t> only;
     // Called with the fraction done, from any thread, at most every 1 %.
     std::function<void(double)> progress;
