@@ -19,6 +19,7 @@
 #include "server/scene_proto.h"
 #include "solver/results/accuracy.h"
 #include "solver/results/export.h"
+#include "solver/scene/subtrees.h"
 #include "solver/solve.h"
 #include "solver/util/error.h"
 #include "solver/util/memory.h"

@@ -11,6 +11,7 @@
 #include "solver/generate/generator.h"
 #include "solver/scene/geometry.h"
 #include "solver/scene/scene_store.h"
+#include "solver/scene/subtrees.h"
 #include "solver/scene/world_frames.h"
 #include "solver/util/error.h"
 #include "tests/scene_builders.h"
@@ -514,6 +515,30 @@ TEST(SceneStore, UndoRestoresTheSceneBefore) {
     store.Apply(change);
     Scene whole = store.Get();
     ExpectSameFlat(store.Flat(), Flatten(whole));
+}
+
+// NodesUnder: a root's whole subtree, however deep and in whatever order the nodes are
+// listed, and nothing of its siblings or parent.
+TEST(NodesUnder, TakesEachRootsWholeSubtreeAndNothingElse) {
+    Scene scene;
+    const auto add = [&](NodeId id, NodeId parent) {
+        Node node;
+        node.id = id;
+        node.parent = parent;
+        scene.nodes.push_back(node);
+    };
+    add(5, 2);  // listed before its parent
+    add(1, kNoParent);
+    add(2, 1);
+    add(3, 1);
+    add(4, 3);
+    add(6, 5);
+    add(7, kNoParent);
+    add(8, 7);
+    EXPECT_EQ(NodesUnder(scene, {2}), (std::unordered_set<NodeId>{2, 5, 6}));
+    EXPECT_EQ(NodesUnder(scene, {3, 7}), (std::unordered_set<NodeId>{3, 4, 7, 8}));
+    EXPECT_EQ(NodesUnder(scene, {1}), (std::unordered_set<NodeId>{1, 2, 3, 4, 5, 6}));
+    EXPECT_EQ(NodesUnder(scene, {}), std::unordered_set<NodeId>{});
 }
 
 }  // namespace

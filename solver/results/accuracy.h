@@ -42,8 +42,4 @@ std::vector<BandAccuracy> CompareWholeStructures(
     const Scene& scene, const FlatScene& flat, const Solution& reference, const Solution& value,
     const std::unordered_set<NodeId>* within = nullptr);
 
-// The nodes under any of `roots` (themselves included): ReferenceOptions::only's receivers
-// and CompareLeaves' `within` for a sample of structures.
-std::unordered_set<NodeId> NodesUnder(const Scene& scene, const std::vector<NodeId>& roots);
-
 }  // namespace leaflux
