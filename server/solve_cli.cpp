@@ -28,7 +28,9 @@ void AddHrcSettings(CLI::App& app, HrcOptions& hrc, const std::string& prefix,
                    label + "rays estimating each link's visibility")
         ->check(CLI::Range(1, 1024));
     app.add_option(prefix + "source-rays", hrc.sourceRays,
-                   label + "rays estimating the visibility of each link from a sun or sky cone")
+                   label +
+                       "rays estimating the visibility of each link from a sun or sky cone; "
+                       "up to twice as many from one bringing most of the light")
         ->check(CLI::Range(1, 1024));
     app.add_option(
            prefix + "cluster-tolerance", hrc.clusterTolerance,

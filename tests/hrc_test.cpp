@@ -10,6 +10,7 @@
 
 #include "solver/generate/generator.h"
 #include "solver/radiosity/form_factor.h"
+#include "solver/radiosity/visibility.h"
 #include "solver/results/accuracy.h"
 #include "solver/solve.h"
 #include "solver/util/directions.h"
@@ -604,6 +605,21 @@ TEST(HrcSky, LinksIntoClustersOfLeavesAreHeldToEpsilonOverRootOfSources) {
         CompareLeaves(scene, prepared.Flat(), direct(1e-6), direct(1e-3));
     EXPECT_LT(accuracy[0].l2PctOfMax, 2.0);
     RecordProperty("l2_pct_of_max_at_1e-3", std::to_string(accuracy[0].l2PctOfMax));
+}
+
+// A sun bringing most of the light has its shadow edges' error to itself, the cones of a sky
+// share theirs: its links take up to twice the rays, 2 × base × √(its share).
+TEST(SourceRays, ASunBringingMostOfTheLightTakesMoreAndTheConesTheBase) {
+    const Channels channels{2, 1, ChannelMeasure::kSum};
+    std::vector<DirectionalSource> sources(5);
+    sources[0].normalIrradiance = {400.0, 380.0};  // 78 % of the light: ⌈64 √0.78⌉ = 57
+    for (int cone = 1; cone < 5; ++cone) sources[cone].normalIrradiance = {30.0, 25.0};
+    EXPECT_EQ(SourceRayCounts(sources, channels, 32), (std::vector<int>{57, 32, 32, 32, 32}));
+    sources.resize(1);  // alone, twice the base
+    EXPECT_EQ(SourceRayCounts(sources, channels, 32), std::vector<int>{64});
+    EXPECT_EQ(SourceRayCounts(sources, channels, 1), std::vector<int>{2});
+    sources[0].normalIrradiance = {0.0, 0.0};  // dark: the base
+    EXPECT_EQ(SourceRayCounts(sources, channels, 32), std::vector<int>{32});
 }
 
 TEST(Hrc, RefusesPeriodicDomainsWithATypedError) {

@@ -128,7 +128,8 @@ class SceneSolve {
           occlusion_(level.occlusion ? *level.occlusion : *ownOcclusion_),
           level_(level),
           estimator_(model_, field_),
-          visibility_(model_, field_, occlusion_, options.visibilityRays, options.sourceRays),
+          visibility_(model_, field_, occlusion_, options.visibilityRays, options.sourceRays,
+                      sources_),
           pushPull_(model_, traversal_, exposure_) {
         field_.Resize(hierarchy_.Size());
         field_.intensity.Assign(model_.SlotCount());

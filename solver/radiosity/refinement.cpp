@@ -129,11 +129,11 @@ Refiner::Verdict Refiner::JudgeSource(std::uint32_t r, std::uint32_t s) const {
     // The spread is least when every ray agrees: beyond ε even then, no ray can save
     // the link, and none is traced.
     const double threshold = SourceThreshold(r);
-    if (unoccluded * VisibilitySpread(1.0, visibility_.SourceRays()) > threshold && CanSplit(r))
+    if (unoccluded * VisibilitySpread(1.0, visibility_.SourceRays(s)) > threshold && CanSplit(r))
         return Verdict::Of(Verdict::kSplitReceiver);
     Verdict verdict;
     const double v = visibility_.FromSource(r, s, source, RaySet::kJudging, verdict.rays);
-    const double error = unoccluded * VisibilitySpread(v, visibility_.SourceRays());
+    const double error = unoccluded * VisibilitySpread(v, visibility_.SourceRays(s));
     if (error > threshold && CanSplit(r)) {
         verdict.kind = Verdict::kSplitReceiver;
         return verdict;

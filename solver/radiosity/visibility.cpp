@@ -1,6 +1,7 @@
 #include "solver/radiosity/visibility.h"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "solver/util/box.h"
@@ -42,12 +43,37 @@ class EndPoints {
 };
 }  // namespace
 
-int LinkVisibility::ConeRings(int count) {
-    int rings = 1;
-    for (int d = 1; d * d <= count; ++d) {
-        if (count % d == 0) rings = d;
+std::vector<int> SourceRayCounts(std::span<const DirectionalSource> sources,
+                                 const Channels& channels, int base) {
+    double total = 0.0;
+    for (const DirectionalSource& source : sources)
+        total += channels.Measure(source.normalIrradiance.data());
+    std::vector<int> counts;
+    for (const DirectionalSource& source : sources) {
+        const double share =
+            total > 0.0 ? channels.Measure(source.normalIrradiance.data()) / total : 0.0;
+        const int more = static_cast<int>(std::ceil(2.0 * base * std::sqrt(share)));
+        counts.push_back(std::max(base, more));
     }
-    return rings;
+    return counts;
+}
+
+LinkVisibility::LinkVisibility(const NodeModel& model, const Field& field,
+                               const Occlusion& occlusion, int visibilityRays, int sourceRays,
+                               std::span<const DirectionalSource> sources)
+    : hierarchy_(model.Nodes()),
+      model_(model),
+      field_(field),
+      occlusion_(occlusion),
+      visibilityRays_(visibilityRays),
+      visibilityLattice_(RankOneLattice::Of(visibilityRays)) {
+    for (int count : SourceRayCounts(sources, model.ChannelSet(), sourceRays)) {
+        int rings = 1;  // the largest divisor of count not over √count
+        for (int d = 1; d * d <= count; ++d) {
+            if (count % d == 0) rings = d;
+        }
+        sourceSampling_.push_back({&RankOneLattice::Of(count), rings, count / rings});
+    }
 }
 
 double LinkVisibility::ClosedBrightness(std::int32_t closed, const glm::dvec3& towardQ) const {
@@ -218,7 +244,8 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
                                   const DirectionalSource& light, RaySet set,
                                   std::int64_t& rays) const {
     Random random(StreamSeed(set == RaySet::kJudging ? 0x50C : 0x50D, r, source));
-    const int count = sourceRays_;
+    const SourceSampling& sampling = sourceSampling_[source];
+    const int count = sampling.lattice->Count();
     const bool beam = light.cosRadius >= 1.0;
     thread_local std::vector<RayStart> starts;
     thread_local std::vector<glm::dvec3> directions;
@@ -233,13 +260,13 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
     thread_local std::vector<int> cells;
     if (!beam) RandomStrata(random, cells, count);
     for (int i = 0; i < count; ++i) {
-        const glm::dvec2 at = sourceLattice_.Point(i, shift);
+        const glm::dvec2 at = sampling.lattice->Point(i, shift);
         const Hierarchy::Point p = hierarchy_.Sample(r, at.x, at.y);
         glm::dvec3 toward = light.toward;
         if (!beam) {
             const int cell = cells[i];
-            toward = light.Direction((cell % coneRings_ + random.Uniform()) / coneRings_,
-                                     (cell / coneRings_ + random.Uniform()) / coneTurns_);
+            toward = light.Direction((cell % sampling.rings + random.Uniform()) / sampling.rings,
+                                     (cell / sampling.rings + random.Uniform()) / sampling.turns);
         }
         const double weight = model_.ReceivingWeight(p.triangle, p.normal, toward);
         if (weight <= 0.0) continue;
