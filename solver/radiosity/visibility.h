@@ -45,13 +45,13 @@ struct Sight {
 
 // The rays of each source's links: `base`, and more for a source that brings much of the
 // light, up to twice `base` for one that brings it all: 2 base √(its share of the sources'
-// normal irradiance), rounded up. A leaf takes each source's light
-// through one link, whose visibility varies by v(1 − v)/n from n rays; light spread over
-// many cones averages their errors out, a sun's is its own. A sun's shadow edges were the
-// 119k-leaf tree's largest error: its sun (78 % of the light) at 57 rays and the 46 sky
-// cones at 32 took its PAR from 1.66 to 1.34 % L2 of max, its NIR from 2.16 to 1.97 %, for
-// 11 % more rays (instanced, ε = 1e-4); all at 64, PAR to 1.29 % for 35 % more; the sun at
-// 64 and the cones at 8, 1.39 %.
+// normal irradiance), rounded up. A leaf takes each source's light through one link, whose
+// visibility varies by v(1 − v)/n from n rays; light spread over many cones averages their
+// errors out, a sun's is its own. A sun's shadow edges were the 119k-leaf tree's largest
+// error: its sun (78 % of the light) at 57 rays and the 46 sky cones at 32 took its PAR
+// from 1.66 to 1.34 % L2 of max, its NIR from 2.16 to 1.97 %, for 11 % more rays
+// (instanced, ε = 1e-4); all at 64, PAR to 1.29 % for 35 % more; the sun at 64 and the
+// cones at 8, 1.39 %: a cone's link sits on a cluster, whose leaves all share its noise.
 std::vector<int> SourceRayCounts(std::span<const DirectionalSource> sources,
                                  const Channels& channels, int base);
 
