@@ -343,6 +343,23 @@ void Plot(const ErrorBenchOptions& options) {
     }
 }
 
+// `count` of the scene's plants spread evenly through them by id (--sample-plants).
+std::vector<NodeId> EvenlySpreadPlants(const Scene& scene, int count) {
+    std::vector<NodeId> plants;
+    for (const Node& node : scene.nodes)
+        if (node.type == NodeType::kPlant) plants.push_back(node.id);
+    std::sort(plants.begin(), plants.end());
+    if (plants.size() < static_cast<std::size_t>(count)) {
+        throw InputError(ErrorCode::kInvalidArgument, "--sample-plants",
+                         "the scene has " + std::to_string(plants.size()) + " plants, fewer than " +
+                             std::to_string(count));
+    }
+    std::vector<NodeId> sampled;
+    for (int k = 0; k < count; ++k)
+        sampled.push_back(plants[(2 * k + 1) * plants.size() / (2 * count)]);
+    return sampled;
+}
+
 }  // namespace
 
 std::string DefaultCacheDirectory() {
@@ -357,24 +374,12 @@ int RunErrorBench(const ErrorBenchOptions& options) {
     const std::string& name = options.name;
     PreparedScene prepared(scene);
     const FlatScene& flat = prepared.Flat();
-    // A sample of the plants (samplePlants), evenly through the scene's by id: the
-    // reference is solved for their organs alone and every error taken over their leaves.
+    // A sample of the plants: the reference is solved for their organs alone and every
+    // error taken over their leaves.
     std::optional<std::unordered_set<NodeId>> sample;
     SolverSettings referenceSettings;
     if (options.samplePlants > 0) {
-        std::vector<NodeId> plants;
-        for (const Node& node : scene.nodes)
-            if (node.type == NodeType::kPlant) plants.push_back(node.id);
-        std::sort(plants.begin(), plants.end());
-        if (plants.size() < static_cast<std::size_t>(options.samplePlants)) {
-            throw InputError(ErrorCode::kInvalidArgument, "--sample-plants",
-                             "the scene has " + std::to_string(plants.size()) +
-                                 " plants, fewer than " + std::to_string(options.samplePlants));
-        }
-        std::vector<NodeId> sampled;
-        for (int k = 0; k < options.samplePlants; ++k)
-            sampled.push_back(plants[(2 * k + 1) * plants.size() / (2 * options.samplePlants)]);
-        sample = NodesUnder(scene, sampled);
+        sample = NodesUnder(scene, EvenlySpreadPlants(scene, options.samplePlants));
         for (std::uint32_t r = 0; r < flat.receivers.size(); ++r) {
             const Receiver& receiver = flat.receivers[r];
             if (receiver.kind == ReceiverKind::kOrgan && sample->count(receiver.node))

@@ -498,11 +498,11 @@ Solution SolveGroup(const Scene& scene, const FlatScene& flat, const RayScene& r
     const int threads = CoresOf(options.threads);
     const auto solved =
         options.only.empty() ? receivers : static_cast<std::uint32_t>(options.only.size());
+    for (std::uint32_t r : options.only) LEAFLUX_CHECK(r < receivers);
     OnCores(threads, [&] {
         tbb::parallel_for(std::uint32_t{0}, solved, [&](std::uint32_t i) {
             SetFlushToZero();
             const std::uint32_t r = options.only.empty() ? i : options.only[i];
-            LEAFLUX_CHECK(r < receivers);
             const Receiver& receiver = flat.receivers[r];
             const SideOptics& optics = tracer.Optics(r);
             std::int64_t receiverRays = 0;
