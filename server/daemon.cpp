@@ -316,7 +316,7 @@ Session::Solved Session::Solve(const v1::OutputRequest& outputs) const {
             const Receiver& receiver = prepared.Flat().receivers[r];
             v1::OrganLight* organ = result.add_organs();
             organ->set_node(receiver.node);
-            organ->set_name(receiver.name);
+            organ->set_name(ReceiverName(solved, receiver));
             organ->set_area_m2(receiver.areaM2);
             BandsToProto(solved, solution.light[r], solution.ErrorOf(r), wanted, lightVectors,
                          organ->mutable_bands());

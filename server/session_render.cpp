@@ -86,7 +86,7 @@ Solution SolutionOf(const Scene& scene, const FlatScene& flat, const v1::CycleRe
                          "its last cycle returned no organ light: ask outputs.leaves");
     std::map<std::string, std::size_t> receivers;
     for (std::size_t r = 0; r < flat.receivers.size(); ++r)
-        receivers.emplace(flat.receivers[r].name, r);
+        receivers.emplace(ReceiverName(scene, flat.receivers[r]), r);
     Solution solution;
     solution.light.assign(flat.receivers.size(), scene.bands.size());
     solution.unsolved.assign(flat.receivers.size(), 1);

@@ -190,7 +190,8 @@ TEST(FilterT, LayersAreLitOneHalfQuarterAndGroundEighth) {
         const double lit = (light.irradianceUpperWm2 + light.irradianceLowerWm2) / 1000.0;
         const BandError& stderrs = solution.error[r][0];
         const double error = std::hypot(stderrs.upperWm2, stderrs.lowerWm2) / 1000.0;
-        EXPECT_NEAR(lit, expected[r], 4.6 * error + 1e-12) << prepared.Flat().receivers[r].name;
+        EXPECT_NEAR(lit, expected[r], 4.6 * error + 1e-12)
+            << ReceiverName(prepared.Source(), prepared.Flat().receivers[r]);
     }
 }
 

@@ -344,7 +344,9 @@ Scene SmallTree(BandOptics leaf) {
 }
 
 // Mean relative error over leaves getting at least 5 % of the brightest leaf's light.
-double MeanRelativeError(const FlatScene& flat, const Solution& value, const Solution& reference) {
+double MeanRelativeError(const PreparedScene& prepared, const Solution& value,
+                         const Solution& reference) {
+    const FlatScene& flat = prepared.Flat();
     double largest = 0.0, sum = 0.0;
     int count = 0;
     auto total = [](const BandLight& l) { return l.irradianceUpperWm2 + l.irradianceLowerWm2; };
@@ -352,7 +354,9 @@ double MeanRelativeError(const FlatScene& flat, const Solution& value, const Sol
         largest = std::max(largest, total(reference.light[r][0]));
     for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
         const double expected = total(reference.light[r][0]);
-        if (flat.receivers[r].name.rfind("leaf", 0) != 0 || expected < 0.05 * largest) continue;
+        if (ReceiverName(prepared.Source(), flat.receivers[r]).rfind("leaf", 0) != 0 ||
+            expected < 0.05 * largest)
+            continue;
         sum += std::abs(total(value.light[r][0]) - expected) / expected;
         ++count;
     }
@@ -368,7 +372,7 @@ TEST(HrcTree, ErrorAgainstMonteCarloFallsWithEpsilon) {
     double previous = 1e300;
     for (double epsilon : {1e-3, 1e-4, 1e-5}) {
         const Solution hrc = SolveWithHrc(prepared, epsilon);
-        const double error = MeanRelativeError(prepared.Flat(), hrc, reference);
+        const double error = MeanRelativeError(prepared, hrc, reference);
         EXPECT_LT(error, previous) << "epsilon " << epsilon;
         RecordProperty("mean_relative_error_at_" + std::to_string(epsilon), std::to_string(error));
         previous = error;
@@ -515,9 +519,9 @@ TEST(HrcExposure, SharesOutTheLightAClusterGathersTowardsTheOpenLeaf) {
         const double evenError =
             std::abs(even.light[r][0].irradianceUpperWm2 - want.irradianceUpperWm2);
         std::printf("%s: reference %.4g ± %.2g, exposure %.4g, even %.4g W/m²\n",
-                    prepared.Flat().receivers[r].name.c_str(), want.irradianceUpperWm2,
-                    reference.error[r][0].upperWm2, open.light[r][0].irradianceUpperWm2,
-                    even.light[r][0].irradianceUpperWm2);
+                    ReceiverName(scene, prepared.Flat().receivers[r]).c_str(),
+                    want.irradianceUpperWm2, reference.error[r][0].upperWm2,
+                    open.light[r][0].irradianceUpperWm2, even.light[r][0].irradianceUpperWm2);
         EXPECT_LT(error, 0.5 * evenError - 4.6 * reference.error[r][0].upperWm2);
     }
 }

@@ -178,7 +178,8 @@ suns { direction { x: 0 y: 0 z: 1 } normal_irradiance { key: "PAR" value: 400 } 
         if (receiver.node != 6 && receiver.node != 8) continue;
         ++leaves;
         // Flat leaves in full sun, nothing above them.
-        EXPECT_NEAR(solution.light[r][0].irradianceUpperWm2, 400.0, 1e-6) << receiver.name;
+        EXPECT_NEAR(solution.light[r][0].irradianceUpperWm2, 400.0, 1e-6)
+            << "node " << receiver.node;
     }
     EXPECT_EQ(leaves, 2);
 }

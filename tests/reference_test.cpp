@@ -24,9 +24,10 @@ constexpr double kRounding = 1e-9;
 struct Solved {
     FlatScene flat;
     Solution solution;
+    std::vector<std::string> names;  // by receiver
     std::size_t Receiver(const std::string& name) const {
-        for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
-            if (flat.receivers[r].name == name) return r;
+        for (std::size_t r = 0; r < names.size(); ++r) {
+            if (names[r] == name) return r;
         }
         throw std::runtime_error("no receiver " + name);
     }
@@ -41,7 +42,9 @@ struct Solved {
 
 Solved Solve(const Scene& scene, int samples = 4096, std::uint64_t seed = 7, int threads = 0) {
     scene.Validate();
-    Solved solved{Flatten(scene), {}};
+    Solved solved{Flatten(scene), {}, {}};
+    for (const auto& receiver : solved.flat.receivers)
+        solved.names.push_back(ReceiverName(scene, receiver));
     std::optional<PeriodicDomain> periodic;
     if (scene.periodic) {
         periodic = *scene.periodic;
@@ -204,7 +207,7 @@ TEST(ReferenceOnly, SolvesTheReceiversAskedAsTheWholeSolveDoes) {
     options.only = {1, 3};
     const Solution part = SolveReference(scene, flat, rays, options);
     for (std::uint32_t r = 0; r < flat.receivers.size(); ++r) {
-        SCOPED_TRACE(flat.receivers[r].name);
+        SCOPED_TRACE(ReceiverName(scene, flat.receivers[r]));
         const BandLight &a = whole.light[r][0], &b = part.light[r][0];
         if (r == 1 || r == 3) {
             EXPECT_GT(a.irradianceUpperWm2, 0.0);

@@ -322,7 +322,8 @@ void ExpectSameFlat(const FlatScene& kept, const FlatScene& fresh) {
     EXPECT_EQ(kept.boundsMax, fresh.boundsMax);
     ASSERT_EQ(kept.receivers.size(), fresh.receivers.size());
     for (std::size_t r = 0; r < kept.receivers.size(); ++r) {
-        EXPECT_EQ(kept.receivers[r].name, fresh.receivers[r].name);
+        EXPECT_EQ(kept.receivers[r].kind, fresh.receivers[r].kind);
+        EXPECT_EQ(kept.receivers[r].declared, fresh.receivers[r].declared);
         EXPECT_EQ(kept.receivers[r].node, fresh.receivers[r].node);
         EXPECT_EQ(kept.receivers[r].areaM2, fresh.receivers[r].areaM2);
         EXPECT_EQ(kept.receivers[r].firstTriangle, fresh.receivers[r].firstTriangle);

@@ -106,7 +106,7 @@ void ExpectCloseToReference(const PreparedScene& prepared, const Solution& solut
         const BandLight& want = reference.light[r][0];
         const BandLight& got = solution.light[r][0];
         const BandError wantError = reference.ErrorAt(r, 0), gotError = solution.ErrorAt(r, 0);
-        const std::string& name = prepared.Flat().receivers[r].name;
+        const std::string name = ReceiverName(prepared.Source(), prepared.Flat().receivers[r]);
         for (const auto& [value, expected, error] :
              {std::tuple{got.irradianceUpperWm2, want.irradianceUpperWm2,
                          std::hypot(wantError.upperWm2, gotError.upperWm2)},

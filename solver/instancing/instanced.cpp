@@ -680,13 +680,19 @@ InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& receivers,
     InstancedSolution out;
     // On the cores asked (hrc.threads), the functions computed as well as the problems.
     const int threads = CoresOf(options.hrc.threads);
-    const SceneSignatures signatures = ComputeSignatures(scene, policy);
     SceneOriginals originals;
-    OnCores(threads, [&] {
-        originals = OriginalsOf(scene, signatures, policy, options.originals, database);
-    });
-    const InstanceTree tree(scene, signatures);
+    // The signatures are not needed once the functions and the tree are made.
+    const InstanceTree tree = [&] {
+        const SceneSignatures signatures = ComputeSignatures(scene, policy);
+        OnCores(threads, [&] {
+            originals = OriginalsOf(scene, signatures, policy, options.originals, database);
+        });
+        return InstanceTree(scene, signatures);
+    }();
     InstancedSolve solve(scene, receivers, shadows, tree, originals, options, out);
+    // What the setup freed (the signatures, the scratch of the functions', the tree's and
+    // the ray engine's builds) goes back before the local problems.
+    HandFreedPagesBack();
     const auto start = std::chrono::steady_clock::now();
     OnCores(threads, [&] { solve.Run(); });
     out.stats.solveSeconds =

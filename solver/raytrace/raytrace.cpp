@@ -116,7 +116,7 @@ RayScene::RayScene(const FlatScene& flat, std::optional<PeriodicDomain> periodic
                    std::shared_ptr<RayDevice> device, std::uint32_t triangles)
     : flat_(flat), periodic_(periodic), device_(std::move(device)) {
     const std::size_t count = std::min<std::size_t>(flat.triangles.size(), triangles);
-    BuildMesh(count, [&](float* xyz) {
+    BuildMesh(count, 3 * count, [&](float* xyz, std::uint32_t* indices) {
         for (std::size_t t = 0; t < count; ++t) {
             const Triangle& tri = flat.triangles[t];
             for (const glm::dvec3* corner : {&tri.a, &tri.b, &tri.c}) {
@@ -125,32 +125,33 @@ RayScene::RayScene(const FlatScene& flat, std::optional<PeriodicDomain> periodic
                 *xyz++ = static_cast<float>(corner->z);
             }
         }
+        for (std::size_t i = 0; i < 3 * count; ++i) indices[i] = static_cast<std::uint32_t>(i);
     });
     BuildTop();
 }
 
-RayScene::RayScene(const FlatScene& frame, std::uint32_t triangles,
-                   const std::function<void(float*)>& place, bool compact,
-                   std::shared_ptr<RayDevice> device)
+RayScene::RayScene(const FlatScene& frame, std::uint32_t triangles, std::uint32_t vertices,
+                   const PlaceMesh& place, bool compact, std::shared_ptr<RayDevice> device)
     : flat_(frame), device_(std::move(device)) {
-    BuildMesh(triangles, place, compact);
+    BuildMesh(triangles, vertices, place, compact);
     BuildTop();
 }
 
-void RayScene::BuildMesh(std::size_t count, const std::function<void(float*)>& place,
+void RayScene::BuildMesh(std::size_t triangles, std::size_t vertices, const PlaceMesh& place,
                          bool compact) {
     SetFlushToZero();
     RTCDevice rtc = device_->Get();
     mesh_ = rtcNewScene(rtc);
     rtcSetSceneBuildQuality(mesh_, RTC_BUILD_QUALITY_HIGH);
     if (compact) rtcSetSceneFlags(mesh_, RTC_SCENE_FLAG_COMPACT);
-    if (count > 0) {
+    if (triangles > 0) {
         RTCGeometry geometry = rtcNewGeometry(rtc, RTC_GEOMETRY_TYPE_TRIANGLE);
-        place(static_cast<float*>(rtcSetNewGeometryBuffer(
-            geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * count)));
-        auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-            geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), count));
-        for (std::size_t i = 0; i < 3 * count; ++i) indices[i] = static_cast<unsigned>(i);
+        auto* xyz = static_cast<float*>(rtcSetNewGeometryBuffer(
+            geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertices));
+        auto* indices = static_cast<std::uint32_t*>(
+            rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                    3 * sizeof(std::uint32_t), triangles));
+        place(xyz, indices);
         rtcSetGeometryIntersectFilterFunction(geometry, IgnoreStartTriangle);
         rtcSetGeometryOccludedFilterFunction(geometry, IgnoreStartTriangle);
         rtcCommitGeometry(geometry);
@@ -361,10 +362,15 @@ bool RayScene::Occluded(const RayStart& start, const glm::dvec3& direction,
 }
 
 std::unique_ptr<RayScene> SceneRays(const Scene& scene, const FlatScene& receivers, bool compact) {
-    std::uint32_t triangles = 0;
-    for (const Receiver& receiver : receivers.receivers) triangles += receiver.triangleCount;
+    std::uint32_t triangles = 0, vertices = 0;
+    for (const Receiver& receiver : receivers.receivers) {
+        triangles += receiver.triangleCount;
+        vertices += static_cast<std::uint32_t>(ReceiverMesh(scene, receiver).positions.size());
+    }
     return std::make_unique<RayScene>(
-        receivers, triangles, [&](float* xyz) { PlaceTriangles(scene, receivers, xyz); }, compact);
+        receivers, triangles, vertices,
+        [&](float* xyz, std::uint32_t* indices) { PlaceVertices(scene, receivers, xyz, indices); },
+        compact);
 }
 
 }  // namespace leaflux

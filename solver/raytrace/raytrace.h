@@ -73,13 +73,15 @@ class RayScene {
     RayScene(const FlatScene& flat, std::optional<PeriodicDomain> periodic,
              std::shared_ptr<RayDevice> device = RayDevice::Shared(),
              std::uint32_t triangles = kNoTriangle);
-    // Over `triangles` triangles that `place` writes, 9 floats each, in the frame of
-    // `frame` (origin, bounds; its triangles unused): the whole scene's triangles without a
-    // flat scene of them (PlaceTriangles). Not periodic. `compact`: Embree's compact
-    // hierarchy, whose leaves index the triangles instead of copying them (on a plantation's
-    // 620,000 triangles, 57 MB instead of 79; its solve up to 45 % slower).
-    RayScene(const FlatScene& frame, std::uint32_t triangles,
-             const std::function<void(float*)>& place, bool compact = false,
+    // Over `triangles` triangles of `vertices` vertices that `place` writes, 3 floats a
+    // vertex in the frame of `frame` (origin, bounds; its triangles unused) and 3 vertex
+    // indices a triangle: the whole scene's triangles without a flat scene of them
+    // (PlaceVertices). Not periodic. `compact`: Embree's compact hierarchy, whose leaves
+    // index the vertices instead of copying them (on a plantation's 620,000 triangles, 57 MB
+    // instead of 79; its solve up to 45 % slower).
+    using PlaceMesh = std::function<void(float* xyz, std::uint32_t* indices)>;
+    RayScene(const FlatScene& frame, std::uint32_t triangles, std::uint32_t vertices,
+             const PlaceMesh& place, bool compact = false,
              std::shared_ptr<RayDevice> device = RayDevice::Shared());
     ~RayScene();
     RayScene(const RayScene&) = delete;
@@ -127,7 +129,7 @@ class RayScene {
     bool Periodic() const { return periodic_.has_value(); }
 
   private:
-    void BuildMesh(std::size_t count, const std::function<void(float*)>& place,
+    void BuildMesh(std::size_t triangles, std::size_t vertices, const PlaceMesh& place,
                    bool compact = false);
     void BuildTop();  // the mesh, or its 9 periodic copies
     template <class Direction>

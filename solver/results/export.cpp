@@ -63,8 +63,9 @@ void WriteLeafCsv(std::ostream& out, const Scene& scene, const FlatScene& flat,
     out << "organ,band,area_m2," << kLightColumns;
     for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
         if (!solution.unsolved.empty() && solution.unsolved[r]) continue;
+        const std::string name = ReceiverName(scene, flat.receivers[r]);
         for (std::size_t b = 0; b < scene.bands.size(); ++b) {
-            out << CsvQuoted(flat.receivers[r].name) << ',' << CsvQuoted(scene.bands[b].name) << ','
+            out << CsvQuoted(name) << ',' << CsvQuoted(scene.bands[b].name) << ','
                 << Number(flat.receivers[r].areaM2) << ',';
             const std::span<const BandError> error = solution.ErrorOf(r);
             WriteLight(out, solution.light[r][b], error.empty() ? nullptr : &error[b],

@@ -50,7 +50,7 @@ Solution ReadLeafCsv(const std::string& path, const Scene& scene, const FlatScen
 
     std::unordered_map<std::string, std::uint32_t> receivers;
     for (std::uint32_t r = 0; r < flat.receivers.size(); ++r)
-        receivers.emplace(flat.receivers[r].name, r);
+        receivers.emplace(ReceiverName(scene, flat.receivers[r]), r);
     std::unordered_map<std::string, int> bands;
     for (int b = 0; b < static_cast<int>(scene.bands.size()); ++b)
         bands.emplace(scene.bands[b].name, b);

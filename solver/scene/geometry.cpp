@@ -15,81 +15,100 @@ struct Flattening {
     std::uint32_t count = 0;
     glm::dvec3 lo{std::numeric_limits<double>::max()}, hi{-std::numeric_limits<double>::max()};
 
-    void Add(const std::vector<Triangle>& placed, Receiver receiver) {
-        receiver.firstTriangle = count;
-        const auto receiverIndex = static_cast<std::uint32_t>(flat.receivers.size());
-        for (Triangle t : placed) {
-            t.receiver = receiverIndex;
-            receiver.areaM2 += t.areaM2;
+    // Widens the bounds to the triangles; returns their area.
+    double Bound(const std::vector<Triangle>& placed) {
+        double area = 0.0;
+        for (const Triangle& t : placed) {
+            area += t.areaM2;
             lo = glm::min(lo, glm::min(t.a, glm::min(t.b, t.c)));
             hi = glm::max(hi, glm::max(t.a, glm::max(t.b, t.c)));
-            if (keep) triangles.push_back(t);
         }
-        count += static_cast<std::uint32_t>(placed.size());
-        receiver.triangleCount = count - receiver.firstTriangle;
-        flat.receivers.push_back(std::move(receiver));
+        return area;
+    }
+    // The next receiver, of so many triangles (its area set).
+    void Append(Receiver receiver, std::size_t triangleCount) {
+        receiver.firstTriangle = count;
+        receiver.triangleCount = static_cast<std::uint32_t>(triangleCount);
+        count += receiver.triangleCount;
+        flat.receivers.push_back(receiver);
+    }
+    void Add(const std::vector<Triangle>& placed, Receiver receiver) {
+        receiver.areaM2 = Bound(placed);
+        if (keep) {
+            for (Triangle t : placed) {
+                t.receiver = static_cast<std::uint32_t>(flat.receivers.size());
+                triangles.push_back(t);
+            }
+        }
+        Append(receiver, placed.size());
+    }
+    // The flat scene, in the frame centred on its bounds.
+    FlatScene Finish() {
+        if (count == 0) return std::move(flat);
+        flat.origin = 0.5 * (lo + hi);
+        for (Triangle& t : triangles) {
+            t.a -= flat.origin;
+            t.b -= flat.origin;
+            t.c -= flat.origin;
+        }
+        flat.boundsMin = lo - flat.origin;
+        flat.boundsMax = hi - flat.origin;
+        flat.triangles = std::move(triangles);
+        return std::move(flat);
     }
 };
 
-// Each receiver of the scene in the flat scene's order — the organs, the environment's
-// surfaces, the emitters — as visit(its triangles placed in the world, a function making
-// its Receiver).
+Receiver OrganReceiver(const Scene& scene, std::size_t n) {
+    const Node& node = scene.nodes[n];
+    return Receiver{ReceiverKind::kOrgan, static_cast<std::uint32_t>(n), node.id,
+                    scene.OpticsIndex(node.organ->opticsId)};
+}
+
+// The receivers after the organs, in the flat scene's order — the environment's surfaces,
+// the emitters — as visit(its triangles placed in the world, a function making its
+// Receiver).
 template <class Visit>
-void ForEachReceiver(const Scene& scene, const PlacedOrgans& placed, const Visit& visit) {
-    for (const Node& node : scene.nodes) {
-        if (!node.organ) continue;
-        visit(placed(node), [&] {
-            return Receiver{scene.NodeName(node), ReceiverKind::kOrgan, node.id,
-                            scene.OpticsIndex(node.organ->opticsId)};
-        });
-    }
-    for (const Surface& surface : scene.environment) {
+void ForEachSurfaceAndEmitter(const Scene& scene, const Visit& visit) {
+    for (std::size_t s = 0; s < scene.environment.size(); ++s) {
+        const Surface& surface = scene.environment[s];
         visit(PlaceMesh(*surface.mesh, glm::dmat4(1.0)), [&] {
-            return Receiver{surface.name, ReceiverKind::kEnvironment, 0,
+            return Receiver{ReceiverKind::kEnvironment, static_cast<std::uint32_t>(s), 0,
                             scene.OpticsIndex(surface.opticsId)};
         });
     }
     for (std::size_t e = 0; e < scene.sources.emitters.size(); ++e) {
         const Emitter& emitter = scene.sources.emitters[e];
         visit(PlaceMesh(*emitter.mesh, glm::dmat4(1.0)), [&] {
-            return Receiver{emitter.name,
-                            emitter.held ? ReceiverKind::kHeld : ReceiverKind::kEmitter, 0,
+            return Receiver{emitter.held ? ReceiverKind::kHeld : ReceiverKind::kEmitter,
+                            static_cast<std::uint32_t>(e), 0,
                             emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId),
                             static_cast<int>(e)};
         });
     }
 }
 
-// Flatten, with or without the triangles.
-FlatScene FlattenScene(const Scene& scene, const PlacedOrgans& placed, bool keep) {
-    Flattening out;
-    out.keep = keep;
-    ForEachReceiver(scene, placed,
-                    [&](const std::vector<Triangle>& triangles, const auto& receiver) {
-                        out.Add(triangles, receiver());
-                    });
-    FlatScene& flat = out.flat;
-    if (out.count == 0) return flat;
-    flat.origin = 0.5 * (out.lo + out.hi);
-    for (Triangle& t : out.triangles) {
-        t.a -= flat.origin;
-        t.b -= flat.origin;
-        t.c -= flat.origin;
-    }
-    flat.boundsMin = out.lo - flat.origin;
-    flat.boundsMax = out.hi - flat.origin;
-    flat.triangles = std::move(out.triangles);
-    return flat;
+// Each organ's triangles placed by its world frame, as visit(its node's index in
+// Scene::nodes, the triangles), parents before children. The frames are not kept
+// (ForEachWorldFrame): WorldFrames' 136 bytes a node took 15 MB of the 119k-leaf tree's
+// setup.
+template <class Visit>
+void ForEachPlacedOrgan(const Scene& scene, const Visit& visit) {
+    ForEachWorldFrame(scene, [&](const Node& node, const glm::dmat4& worldFromLocal) {
+        if (node.organ)
+            visit(static_cast<std::size_t>(&node - scene.nodes.data()),
+                  PlaceMesh(*node.organ->mesh, worldFromLocal));
+    });
 }
 
-PlacedOrgans PlacedByFrame(const Scene& scene, std::vector<Triangle>& placed) {
-    return [&placed, worldFromLocal =
-                         WorldFromLocal(scene)](const Node& organ) -> const std::vector<Triangle>& {
-        placed = PlaceMesh(*organ.organ->mesh, worldFromLocal.at(organ.id));
-        return placed;
-    };
-}
 }  // namespace
+
+std::string ReceiverName(const Scene& scene, const Receiver& receiver) {
+    if (receiver.kind == ReceiverKind::kOrgan)
+        return scene.NodeName(scene.nodes.at(receiver.declared));
+    if (receiver.kind == ReceiverKind::kEnvironment)
+        return scene.environment.at(receiver.declared).name;
+    return scene.sources.emitters.at(receiver.declared).name;  // an emitter, held or not
+}
 
 std::vector<Triangle> PlaceMesh(const Mesh& mesh, const glm::dmat4& worldFromLocal) {
     std::vector<Triangle> placed;
@@ -108,33 +127,86 @@ std::vector<Triangle> PlaceMesh(const Mesh& mesh, const glm::dmat4& worldFromLoc
     return placed;
 }
 
+FlatScene Flatten(const Scene& scene, const PlacedOrgans& placed) {
+    Flattening out;
+    for (std::size_t n = 0; n < scene.nodes.size(); ++n)
+        if (scene.nodes[n].organ) out.Add(placed(scene.nodes[n]), OrganReceiver(scene, n));
+    ForEachSurfaceAndEmitter(scene, [&](const std::vector<Triangle>& triangles,
+                                        const auto& receiver) { out.Add(triangles, receiver()); });
+    return out.Finish();
+}
+
 FlatScene Flatten(const Scene& scene) {
+    const WorldFrames worldFromLocal(scene);
     std::vector<Triangle> placed;
-    return FlattenScene(scene, PlacedByFrame(scene, placed), true);
+    return Flatten(scene, [&](const Node& organ) -> const std::vector<Triangle>& {
+        placed = PlaceMesh(*organ.organ->mesh, worldFromLocal.at(organ.id));
+        return placed;
+    });
 }
 
 FlatScene ReceiversOf(const Scene& scene) {
-    std::vector<Triangle> placed;
-    return FlattenScene(scene, PlacedByFrame(scene, placed), false);
+    Flattening out;
+    out.keep = false;
+    std::vector<double> areas(scene.nodes.size(), 0.0);
+    ForEachPlacedOrgan(scene, [&](std::size_t n, const std::vector<Triangle>& placed) {
+        areas[n] = out.Bound(placed);
+    });
+    for (std::size_t n = 0; n < scene.nodes.size(); ++n) {
+        if (!scene.nodes[n].organ) continue;
+        Receiver receiver = OrganReceiver(scene, n);
+        receiver.areaM2 = areas[n];
+        out.Append(receiver, scene.nodes[n].organ->mesh->triangles.size());
+    }
+    ForEachSurfaceAndEmitter(scene, [&](const std::vector<Triangle>& triangles,
+                                        const auto& receiver) { out.Add(triangles, receiver()); });
+    return out.Finish();
 }
 
-FlatScene Flatten(const Scene& scene, const PlacedOrgans& placed) {
-    return FlattenScene(scene, placed, true);
+const Mesh& ReceiverMesh(const Scene& scene, const Receiver& receiver) {
+    if (receiver.kind == ReceiverKind::kOrgan)
+        return *scene.nodes.at(receiver.declared).organ->mesh;
+    if (receiver.kind == ReceiverKind::kEnvironment)
+        return *scene.environment.at(receiver.declared).mesh;
+    return *scene.sources.emitters.at(receiver.declared).mesh;  // an emitter, held or not
 }
 
-void PlaceTriangles(const Scene& scene, const FlatScene& receivers, float* xyz) {
-    std::vector<Triangle> placed;
-    ForEachReceiver(scene, PlacedByFrame(scene, placed),
-                    [&](const std::vector<Triangle>& triangles, const auto&) {
-                        for (const Triangle& t : triangles) {
-                            for (const glm::dvec3& corner : {t.a, t.b, t.c}) {
-                                const glm::dvec3 local = corner - receivers.origin;
-                                *xyz++ = static_cast<float>(local.x);
-                                *xyz++ = static_cast<float>(local.y);
-                                *xyz++ = static_cast<float>(local.z);
-                            }
-                        }
-                    });
+void PlaceVertices(const Scene& scene, const FlatScene& receivers, float* xyz,
+                   std::uint32_t* indices) {
+    const std::vector<Receiver>& all = receivers.receivers;
+    // Each receiver's first vertex; each organ's receiver by its node's index.
+    std::vector<std::uint32_t> firstVertex(all.size()), receiverOf(scene.nodes.size(), 0);
+    std::uint32_t vertices = 0;
+    for (std::uint32_t r = 0; r < all.size(); ++r) {
+        if (all[r].kind == ReceiverKind::kOrgan) receiverOf[all[r].declared] = r;
+        firstVertex[r] = vertices;
+        vertices += static_cast<std::uint32_t>(ReceiverMesh(scene, all[r]).positions.size());
+    }
+    // As PlaceMesh places a triangle's corners.
+    const auto put = [&](const Mesh& mesh, const glm::dmat4& worldFromLocal, std::uint32_t r) {
+        float* at = xyz + 3 * static_cast<std::size_t>(firstVertex[r]);
+        for (const glm::dvec3& position : mesh.positions) {
+            const glm::dvec3 local =
+                glm::dvec3(worldFromLocal * glm::dvec4(position, 1.0)) - receivers.origin;
+            *at++ = static_cast<float>(local.x);
+            *at++ = static_cast<float>(local.y);
+            *at++ = static_cast<float>(local.z);
+        }
+        std::uint32_t* index = indices + 3 * static_cast<std::size_t>(all[r].firstTriangle);
+        for (const glm::uvec3& triangle : mesh.triangles) {
+            for (int k = 0; k < 3; ++k) *index++ = firstVertex[r] + triangle[k];
+        }
+    };
+    // The organs by their world frames, not kept (ForEachWorldFrame); the others as declared.
+    ForEachWorldFrame(scene, [&](const Node& node, const glm::dmat4& worldFromLocal) {
+        if (node.organ)
+            put(*node.organ->mesh, worldFromLocal,
+                receiverOf[static_cast<std::size_t>(&node - scene.nodes.data())]);
+    });
+    for (std::uint32_t r = 0; r < all.size(); ++r) {
+        if (all[r].kind != ReceiverKind::kOrgan)
+            put(ReceiverMesh(scene, all[r]), glm::dmat4(1.0), r);
+    }
 }
 
 }  // namespace leaflux

@@ -23,9 +23,13 @@ namespace leaflux {
 // balance and has no output.
 enum class ReceiverKind { kOrgan, kEnvironment, kEmitter, kHeld };
 
+// 40 bytes. Its name is the scene's (ReceiverName): kept here, it took 32 bytes more, 8 MB
+// on a plantation.
 struct Receiver {
-    std::string name;
     ReceiverKind kind = ReceiverKind::kOrgan;
+    // Where the scene declares it: its node's index in Scene::nodes, its surface's in
+    // Scene::environment, its emitter's in Sources::emitters.
+    std::uint32_t declared = 0;
     NodeId node = 0;   // the organ's node; 0 for environment surfaces and emitters
     int optics = -1;   // index into Scene::optics; -1: black (an emitter without optics)
     int emitter = -1;  // index into Sources::emitters when kind == kEmitter
@@ -33,6 +37,10 @@ struct Receiver {
     std::uint32_t firstTriangle = 0;
     std::uint32_t triangleCount = 0;
 };
+
+// The name of a receiver of the scene's flat scene: its node's (Scene::NodeName), its
+// surface's or its emitter's.
+std::string ReceiverName(const Scene& scene, const Receiver& receiver);
 
 struct Triangle {
     glm::dvec3 a, b, c;  // relative to FlatScene::origin
@@ -58,10 +66,16 @@ FlatScene Flatten(const Scene& scene);
 // triangle ranges, and the frame (origin, bounds). What per-receiver results are indexed by
 // when the scene is never flattened whole (the instanced solver).
 FlatScene ReceiversOf(const Scene& scene);
-// Every triangle as Flatten would place it (the organs', then the environment's and the
-// emitters'), straight into 9 floats each, in the frame of `receivers` (ReceiversOf the
-// scene): a ray engine's without the flat scene.
-void PlaceTriangles(const Scene& scene, const FlatScene& receivers, float* xyz);
+// The mesh a receiver of the scene's flat scene has: its organ's, surface's or emitter's.
+const Mesh& ReceiverMesh(const Scene& scene, const Receiver& receiver);
+// The scene's vertices placed once each: every receiver's mesh's positions as Flatten
+// would place them, in the receivers' order, straight into 3 floats each in the frame of
+// `receivers` (ReceiversOf the scene); and every triangle, in Flatten's order, as the
+// indices of its three. A ray engine's mesh without the flat scene: on a plantation 13 MB
+// of vertices, where its triangles' corners one by one took 22. `xyz` holds 3 floats for
+// each of ReceiverMesh's positions, `indices` 3 for each triangle.
+void PlaceVertices(const Scene& scene, const FlatScene& receivers, float* xyz,
+                   std::uint32_t* indices);
 
 // A mesh's triangles placed by worldFromLocal, in world coordinates (receiver 0).
 std::vector<Triangle> PlaceMesh(const Mesh& mesh, const glm::dmat4& worldFromLocal);

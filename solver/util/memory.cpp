@@ -30,12 +30,14 @@ std::int64_t PeakRssBytes() {
 }
 
 std::int64_t ResidentBytes() {
-    malloc_trim(0);
+    HandFreedPagesBack();
     return std::max<std::int64_t>(StatusBytes("VmRSS:"), 0);
 }
 
+void HandFreedPagesBack() { malloc_trim(0); }
+
 bool ResetPeakRss() {
-    malloc_trim(0);  // what earlier runs freed goes back to the kernel, out of the new peak
+    HandFreedPagesBack();  // what earlier runs freed, out of the new peak
     std::ofstream clearRefs("/proc/self/clear_refs");
     clearRefs << "5";  // 5: reset the peak resident set size to the current one
     clearRefs.flush();

@@ -28,8 +28,8 @@ Run Measure(const PreparedScene& prepared, int samples, double sunIrradiance) {
     std::vector<double> relative;
     for (std::size_t r = 0; r < prepared.Flat().receivers.size(); ++r) {
         if (prepared.Flat().receivers[r].kind != ReceiverKind::kOrgan) continue;
-        const auto& node = prepared.Flat().receivers[r];
-        if (node.name.rfind("leaf", 0) != 0) continue;
+        if (ReceiverName(prepared.Source(), prepared.Flat().receivers[r]).rfind("leaf", 0) != 0)
+            continue;
         const BandLight& nir = solution.light[r][0];
         const double e = nir.irradianceUpperWm2 + nir.irradianceLowerWm2;
         if (e < 0.05 * sunIrradiance) continue;
