@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <limits>
-#include <unordered_map>
+#include <span>
+
+#include "solver/scene/topology.h"
 
 namespace leaflux {
 namespace {
@@ -15,20 +17,13 @@ constexpr double kMinPadM = 1e-6;
 
 InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures) {
     const std::size_t count = scene.nodes.size();
-    std::unordered_map<NodeId, std::size_t> indexOf;
-    indexOf.reserve(count);
-    for (std::size_t i = 0; i < count; ++i) indexOf[scene.nodes[i].id] = i;
-    std::vector<std::vector<std::size_t>> children(count);
-    std::vector<std::size_t> roots;
-    for (std::size_t i = 0; i < count; ++i) {
-        const NodeId parent = scene.nodes[i].parent;
-        (parent == kNoParent ? roots : children[indexOf.at(parent)]).push_back(i);
-    }
+    const Topology topology(scene);
     // Each node's part, depth first from the roots; an instance opens a part of its own.
     parts_.push_back(Part{});
     std::vector<std::uint32_t> owner(count, kTop);
     std::vector<std::pair<std::size_t, std::uint32_t>> stack;
-    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, kTop});
+    for (auto it = topology.Roots().rbegin(); it != topology.Roots().rend(); ++it)
+        stack.push_back({*it, kTop});
     while (!stack.empty()) {
         auto [i, part] = stack.back();
         stack.pop_back();
@@ -45,8 +40,8 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
             parts_.push_back(std::move(instance));
         }
         owner[i] = part;
-        for (auto c = children[i].rbegin(); c != children[i].rend(); ++c)
-            stack.push_back({*c, part});
+        const std::span<const std::uint32_t> children = topology.Children(i);
+        for (auto c = children.rbegin(); c != children.rend(); ++c) stack.push_back({*c, part});
     }
     for (std::size_t i = 0; i < count; ++i) {
         Part& part = parts_[owner[i]];
@@ -64,11 +59,8 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
     // 136 bytes each).
     const auto worldFromRoot = [&](std::size_t i) {
         glm::dmat4 frame(scene.nodes[i].parentFromLocal);
-        for (NodeId up = scene.nodes[i].parent; up != kNoParent;) {
-            const Node& parent = scene.nodes[indexOf.at(up)];
-            frame = glm::dmat4(parent.parentFromLocal) * frame;
-            up = parent.parent;
-        }
+        for (std::uint32_t up = topology.Parent(i); up != Topology::kNone; up = topology.Parent(up))
+            frame = glm::dmat4(scene.nodes[up].parentFromLocal) * frame;
         return frame;
     };
     const auto walkOrgans = [&](const Part& part, const auto& visit) {
@@ -77,7 +69,7 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
             const auto [i, instanceFromNode] = walk.back();
             walk.pop_back();
             if (scene.nodes[i].organ) visit(*scene.nodes[i].organ->mesh, instanceFromNode);
-            for (std::size_t c : children[i])
+            for (const std::size_t c : topology.Children(i))
                 walk.push_back({c, instanceFromNode * glm::dmat4(scene.nodes[c].parentFromLocal)});
         }
     };

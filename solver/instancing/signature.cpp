@@ -3,9 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <span>
 #include <sstream>
-#include <unordered_map>
 
+#include "solver/scene/topology.h"
 #include "solver/util/check.h"
 #include "solver/util/error.h"
 
@@ -14,44 +15,22 @@ namespace {
 
 bool IsLeafOrgan(const Node& node) { return node.type == NodeType::kLeaf && node.organ; }
 
-// Leaf organs in each node's subtree, by position in scene.nodes: children lists, a
-// breadth-first order from the roots, then sums from the last node back to the roots.
+// Leaf organs in each node's subtree, by position in scene.nodes: a breadth-first order
+// from the roots, then sums from the last node back to the roots.
 std::vector<std::int64_t> SubtreeLeafCounts(const Scene& scene) {
     const std::size_t n = scene.nodes.size();
-    std::unordered_map<NodeId, std::size_t> indexOf;
-    indexOf.reserve(n);
-    for (std::size_t i = 0; i < n; ++i) indexOf.emplace(scene.nodes[i].id, i);
-    std::vector<std::size_t> parentOf(n, n);  // n: a root
-    std::vector<std::size_t> childStart(n + 1, 0);
-    for (std::size_t i = 0; i < n; ++i) {
-        const NodeId parent = scene.nodes[i].parent;
-        if (parent == kNoParent) continue;
-        const auto found = indexOf.find(parent);
-        LEAFLUX_CHECK(found != indexOf.end());  // a validated scene's parents resolve
-        parentOf[i] = found->second;
-        ++childStart[found->second + 1];
-    }
-    std::partial_sum(childStart.begin(), childStart.end(), childStart.begin());
-    std::vector<std::size_t> children(childStart[n]);
-    std::vector<std::size_t> fill(childStart.begin(), childStart.end() - 1);
-    for (std::size_t i = 0; i < n; ++i) {
-        if (parentOf[i] != n) children[fill[parentOf[i]]++] = i;
-    }
-    std::vector<std::size_t> order;
+    const Topology topology(scene);
+    std::vector<std::uint32_t> order = topology.Roots();
     order.reserve(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        if (parentOf[i] == n) order.push_back(i);
-    }
     for (std::size_t k = 0; k < order.size(); ++k) {
-        const std::size_t i = order[k];
-        order.insert(order.end(), children.begin() + static_cast<std::ptrdiff_t>(childStart[i]),
-                     children.begin() + static_cast<std::ptrdiff_t>(childStart[i + 1]));
+        const std::span<const std::uint32_t> children = topology.Children(order[k]);
+        order.insert(order.end(), children.begin(), children.end());
     }
     LEAFLUX_CHECK(order.size() == n);  // a validated scene is a forest
     std::vector<std::int64_t> leaves(n, 0);
     for (auto k = order.rbegin(); k != order.rend(); ++k) {
         if (IsLeafOrgan(scene.nodes[*k])) ++leaves[*k];
-        if (parentOf[*k] != n) leaves[parentOf[*k]] += leaves[*k];
+        if (topology.Parent(*k) != Topology::kNone) leaves[topology.Parent(*k)] += leaves[*k];
     }
     return leaves;
 }

@@ -2,10 +2,11 @@
 
 #include <algorithm>
 #include <array>
-#include <unordered_map>
+#include <span>
 #include <vector>
 
 #include "solver/scene/geometry.h"
+#include "solver/scene/topology.h"
 #include "solver/util/error.h"
 
 namespace leaflux {
@@ -16,12 +17,9 @@ constexpr double kMinPadM = 1e-6;
 }  // namespace
 
 StructureAlone::StructureAlone(const Scene& scene, NodeId root) {
-    std::unordered_map<NodeId, std::vector<std::size_t>> children;
     std::optional<std::size_t> rootIndex;
-    for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
-        const Node& node = scene.nodes[i];
-        if (node.id == root) rootIndex = i;
-        if (node.parent != kNoParent) children[node.parent].push_back(i);
+    for (std::size_t i = 0; i < scene.nodes.size() && !rootIndex; ++i) {
+        if (scene.nodes[i].id == root) rootIndex = i;
     }
     if (!rootIndex) throw InputError(ErrorCode::kNotFound, "root", "names no node", root);
     name_ = scene.NodeName(scene.nodes[*rootIndex]);
@@ -29,14 +27,15 @@ StructureAlone::StructureAlone(const Scene& scene, NodeId root) {
     alone_.optics = scene.optics;
     // The subtree in scene order (so that receivers keep the scene's order), its root at
     // the origin of its own frame.
+    const Topology topology(scene);
     std::vector<std::uint8_t> inside(scene.nodes.size(), 0);
     std::vector<std::size_t> stack{*rootIndex};
     while (!stack.empty()) {
         const std::size_t i = stack.back();
         stack.pop_back();
         inside[i] = 1;
-        if (auto it = children.find(scene.nodes[i].id); it != children.end())
-            stack.insert(stack.end(), it->second.begin(), it->second.end());
+        const std::span<const std::uint32_t> children = topology.Children(i);
+        stack.insert(stack.end(), children.begin(), children.end());
     }
     for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
         if (!inside[i]) continue;

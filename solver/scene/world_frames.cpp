@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "solver/scene/topology.h"
+
 namespace leaflux {
 
 WorldFrames::WorldFrames(const Scene& scene) {
@@ -38,39 +40,17 @@ glm::dmat4 WorldFrames::at(NodeId id) const {
 
 void ForEachWorldFrame(const Scene& scene,
                        const std::function<void(const Node&, const glm::dmat4&)>& visit) {
-    const std::size_t n = scene.nodes.size();
-    std::vector<std::pair<NodeId, std::uint32_t>> byId(n);
-    for (std::uint32_t i = 0; i < n; ++i) byId[i] = {scene.nodes[i].id, i};
-    std::sort(byId.begin(), byId.end());
-    const auto indexOf = [&](NodeId id) -> std::int64_t {
-        const auto it = std::lower_bound(byId.begin(), byId.end(), std::pair{id, 0u});
-        return it != byId.end() && it->first == id ? static_cast<std::int64_t>(it->second) : -1;
-    };
-    // Each node's children, in the nodes' order: first[i] .. first[i + 1] of `children`.
-    std::vector<std::uint32_t> first(n + 1, 0), children(n), parentOf(n);
-    std::vector<std::uint32_t> roots;
-    for (std::uint32_t i = 0; i < n; ++i) {
-        const NodeId parent = scene.nodes[i].parent;
-        const std::int64_t p = parent == kNoParent ? -1 : indexOf(parent);
-        parentOf[i] = p < 0 ? static_cast<std::uint32_t>(n) : static_cast<std::uint32_t>(p);
-        if (parent == kNoParent) roots.push_back(i);
-        if (p >= 0) ++first[p + 1];
-    }
-    std::partial_sum(first.begin(), first.end(), first.begin());
-    std::vector<std::uint32_t> filled(first.begin(), first.end() - 1);
-    for (std::uint32_t i = 0; i < n; ++i) {
-        if (parentOf[i] < n) children[filled[parentOf[i]]++] = i;
-    }
+    const Topology topology(scene);
     std::vector<std::pair<std::uint32_t, glm::dmat4>> stack;
-    for (auto r = roots.rbegin(); r != roots.rend(); ++r)
+    for (auto r = topology.Roots().rbegin(); r != topology.Roots().rend(); ++r)
         stack.push_back({*r, glm::dmat4(scene.nodes[*r].parentFromLocal)});
     while (!stack.empty()) {
         const auto [i, frame] = stack.back();
         stack.pop_back();
         visit(scene.nodes[i], frame);
-        for (std::uint32_t k = first[i + 1]; k-- > first[i];)
-            stack.push_back(
-                {children[k], frame * glm::dmat4(scene.nodes[children[k]].parentFromLocal)});
+        const std::span<const std::uint32_t> children = topology.Children(i);
+        for (auto c = children.rbegin(); c != children.rend(); ++c)
+            stack.push_back({*c, frame * glm::dmat4(scene.nodes[*c].parentFromLocal)});
     }
 }
 
