@@ -77,8 +77,8 @@ class RayScene {
     // vertex in the frame of `frame` (origin, bounds; its triangles unused) and 3 vertex
     // indices a triangle: the whole scene's triangles without a flat scene of them
     // (PlaceVertices). Not periodic. `compact`: Embree's compact hierarchy, whose leaves
-    // index the vertices instead of copying them (on a plantation's 620,000 triangles, 57 MB
-    // instead of 79; its solve up to 45 % slower).
+    // index the vertices instead of copying them: a lower peak for a slower solve (the
+    // instanced-compact rows of docs/results.md, "Time and memory against size").
     using PlaceMesh = std::function<void(float* xyz, std::uint32_t* indices)>;
     RayScene(const FlatScene& frame, std::uint32_t triangles, std::uint32_t vertices,
              const PlaceMesh& place, bool compact = false,
