@@ -322,7 +322,7 @@ void SceneSolve::Index() {
         const Receiver& receiver = flat_.receivers[node.receiver];
         if (receiver.kind != ReceiverKind::kEmitter && receiver.kind != ReceiverKind::kHeld)
             continue;
-        const Emitter& emitter = scene_.sources.emitters[receiver.emitter];
+        const Emitter& emitter = scene_.sources.emitters[receiver.declared];
         const std::size_t t = node.triangle - receiver.firstTriangle;
         for (int b = 0; b < channels_.bands; ++b)
             leafLight_.emission[n][b] = emitter.Exitance(t, b);

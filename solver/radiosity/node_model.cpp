@@ -84,7 +84,7 @@ void NodeModel::FindOnward(const Scene& scene) {
         // A black lamp, or held from one (Emitter::lamp).
         lampOf_[r] = receiver.optics < 0 && (receiver.kind == ReceiverKind::kEmitter ||
                                              (receiver.kind == ReceiverKind::kHeld &&
-                                              scene.sources.emitters[receiver.emitter].lamp));
+                                              scene.sources.emitters[receiver.declared].lamp));
         if (receiver.kind == ReceiverKind::kOrgan) {
             onwardOf_[r] = 1.0f;
             continue;

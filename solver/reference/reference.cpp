@@ -58,7 +58,7 @@ class Lights {
         for (std::uint32_t r = 0; r < flat.receivers.size(); ++r) {
             const Receiver& receiver = flat.receivers[r];
             if (receiver.kind != ReceiverKind::kEmitter) continue;
-            const Emitter& emitter = scene.sources.emitters[receiver.emitter];
+            const Emitter& emitter = scene.sources.emitters[receiver.declared];
             const double exitance =
                 std::accumulate(emitter.exitanceWm2.begin(), emitter.exitanceWm2.end(), 0.0);
             // A dark lamp is still a surface, but nothing to sample.

@@ -6,6 +6,12 @@
 
 namespace leaflux {
 namespace {
+// A mesh position placed by worldFromLocal: the one formula of PlaceMesh's corners and
+// PlaceVertices' vertices, so that the ray engine's floats are the flat scene's.
+glm::dvec3 Placed(const glm::dmat4& worldFromLocal, const glm::dvec3& position) {
+    return glm::dvec3(worldFromLocal * glm::dvec4(position, 1.0));
+}
+
 // Flatten's receivers as their triangles are added: each one's area and triangle range, the
 // bounds, and the triangles themselves when `keep` is set.
 struct Flattening {
@@ -81,8 +87,7 @@ void ForEachSurfaceAndEmitter(const Scene& scene, const Visit& visit) {
         visit(PlaceMesh(*emitter.mesh, glm::dmat4(1.0)), [&] {
             return Receiver{emitter.held ? ReceiverKind::kHeld : ReceiverKind::kEmitter,
                             static_cast<std::uint32_t>(e), 0,
-                            emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId),
-                            static_cast<int>(e)};
+                            emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId)};
         });
     }
 }
@@ -115,9 +120,9 @@ std::vector<Triangle> PlaceMesh(const Mesh& mesh, const glm::dmat4& worldFromLoc
     placed.reserve(mesh.triangles.size());
     for (const glm::uvec3& tri : mesh.triangles) {
         Triangle t;
-        t.a = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.x], 1.0));
-        t.b = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.y], 1.0));
-        t.c = glm::dvec3(worldFromLocal * glm::dvec4(mesh.positions[tri.z], 1.0));
+        t.a = Placed(worldFromLocal, mesh.positions[tri.x]);
+        t.b = Placed(worldFromLocal, mesh.positions[tri.y]);
+        t.c = Placed(worldFromLocal, mesh.positions[tri.z]);
         const glm::dvec3 cross = glm::cross(t.b - t.a, t.c - t.a);
         t.areaM2 = 0.5 * glm::length(cross);
         t.normal = cross / (2.0 * t.areaM2);
@@ -182,12 +187,10 @@ void PlaceVertices(const Scene& scene, const FlatScene& receivers, float* xyz,
         firstVertex[r] = vertices;
         vertices += static_cast<std::uint32_t>(ReceiverMesh(scene, all[r]).positions.size());
     }
-    // As PlaceMesh places a triangle's corners.
     const auto put = [&](const Mesh& mesh, const glm::dmat4& worldFromLocal, std::uint32_t r) {
         float* at = xyz + 3 * static_cast<std::size_t>(firstVertex[r]);
         for (const glm::dvec3& position : mesh.positions) {
-            const glm::dvec3 local =
-                glm::dvec3(worldFromLocal * glm::dvec4(position, 1.0)) - receivers.origin;
+            const glm::dvec3 local = Placed(worldFromLocal, position) - receivers.origin;
             *at++ = static_cast<float>(local.x);
             *at++ = static_cast<float>(local.y);
             *at++ = static_cast<float>(local.z);

@@ -30,9 +30,8 @@ struct Receiver {
     // Where the scene declares it: its node's index in Scene::nodes, its surface's in
     // Scene::environment, its emitter's in Sources::emitters.
     std::uint32_t declared = 0;
-    NodeId node = 0;   // the organ's node; 0 for environment surfaces and emitters
-    int optics = -1;   // index into Scene::optics; -1: black (an emitter without optics)
-    int emitter = -1;  // index into Sources::emitters when kind == kEmitter
+    NodeId node = 0;  // the organ's node; 0 for environment surfaces and emitters
+    int optics = -1;  // index into Scene::optics; -1: black (an emitter without optics)
     double areaM2 = 0.0;
     std::uint32_t firstTriangle = 0;
     std::uint32_t triangleCount = 0;
