@@ -61,17 +61,19 @@ void NodeModel::FindOrgans() {
         const HrcNode& node = hierarchy_[n];
         if (node.patch) {
             organs_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kOrgan;
-            held_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kHeld;
+            held_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kHeld ? kAllHeld : 0;
         } else if (node.closed >= 0) {
             const bool held = hierarchy_.Closed()[node.closed].Held();
             organs_[n] = !held;
-            held_[n] = held;
+            held_[n] = held ? kAllHeld : 0;
         } else {
-            held_[n] = !node.children.empty();
+            bool all = !node.children.empty(), any = false;
             for (std::uint32_t child : node.children) {
                 organs_[n] |= organs_[child];
-                held_[n] &= held_[child];
+                all = all && held_[child] == kAllHeld;
+                any = any || held_[child] != 0;
             }
+            held_[n] = all ? kAllHeld : any ? kPartlyHeld : 0;
         }
     }
 }

@@ -67,7 +67,12 @@ class NodeModel {
     bool Held(std::uint32_t n) const {
         const HrcNode& node = hierarchy_[n];
         return node.patch ? flat_.receivers[node.receiver].kind == ReceiverKind::kHeld
-                          : held_[n] != 0;
+                          : held_[n] == kAllHeld;
+    }
+    // n is a cluster holding both: what lands on it would reach held parts, which receive
+    // nothing, and its points may be theirs. It is split before anything links to it.
+    bool PartlyHeld(std::uint32_t n) const {
+        return !hierarchy_[n].patch && held_[n] == kPartlyHeld;
     }
     // n is an organ's patch, or a cluster with organs under it.
     bool HoldsOrgans(std::uint32_t n) const {
@@ -191,7 +196,8 @@ class NodeModel {
     std::vector<std::uint8_t> lampOf_;  // by receiver: Lamp of its patches
     std::vector<std::uint8_t> lamps_;   // by node as built: Lamp
     std::vector<std::uint8_t> organs_;  // by node as built: 1 over an organ
-    std::vector<std::uint8_t> held_;    // by node as built: Held
+    static constexpr std::uint8_t kPartlyHeld = 1, kAllHeld = 2;
+    std::vector<std::uint8_t> held_;    // by node as built: Held, PartlyHeld
     std::vector<std::uint8_t> planes_;  // by node as built: Planar
     std::vector<std::uint32_t> slot_;   // by node: clusters' slots, kNoNode for patches
     std::uint32_t slots_ = 0;

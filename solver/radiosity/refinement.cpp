@@ -53,6 +53,13 @@ void Refiner::Refine(std::vector<Task> stack) {
 
 Refiner::Verdict Refiner::Judge(const Task& task) const {
     if (model_.Held(task.r)) return {};  // sends its held light, receives nothing
+    // A cluster of held and own parts is split first, at either end: a source link on the
+    // root of a local problem, kept at a coarse ε, sampled the held closed instances in it
+    // (and crashed on the 119k-leaf tree at ε = 1e-2).
+    if (task.kind != Task::kSelf && model_.PartlyHeld(task.r))
+        return Verdict::Of(Verdict::kSplitReceiver);
+    if (task.kind == Task::kPair && model_.PartlyHeld(task.s))
+        return Verdict::Of(Verdict::kSplitSender);
     switch (task.kind) {
         case Task::kSource:
             return JudgeSource(task.r, task.s);
