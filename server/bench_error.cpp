@@ -243,6 +243,11 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
             branches.setting += " output=axis per-structure";
             branches.settings.instanced.outputLevel = NodeType::kAxis;
             runs.push_back(branches);
+            // The same, its leaves' light handed down from the branches solved whole.
+            Run pushed = branches;
+            pushed.setting = run.setting + " output=axis pushed-down";
+            pushed.settings.instanced.pushDown = true;
+            runs.push_back(pushed);
             for (int depth : options.instancedDepths) {
                 Run shallow = run;
                 shallow.setting += " depth=" + std::to_string(depth) + " per-structure";
@@ -315,7 +320,7 @@ std::vector<Row> RowsOf(const Run& run, const Scene& scene, const FlatScene& fla
                         const Solution& reference, const Solution& solution,
                         const std::unordered_set<NodeId>* within) {
     const std::vector<BandAccuracy> accuracy =
-        solution.wholeStructures.empty()
+        solution.wholeStructures.empty() || !solution.pushedDown.empty()
             ? CompareLeaves(scene, flat, reference, solution, within)
             : CompareWholeStructures(scene, flat, reference, solution, within);
     std::vector<Row> rows;

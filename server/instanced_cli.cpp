@@ -61,6 +61,11 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
                     "branch")
         ->check(CLI::IsMember({"plant", "axis", "phytomer"}))
         ->excludes(depth);
+    solve.add_flag("--push-down", command.pushDown,
+                   "instanced: with --max-depth or --output-level, the leaves of the structures "
+                   "solved whole get light handed down from the structure's (straight light "
+                   "from its box's sides through its transmittance, what it absorbs beyond that "
+                   "evenly), in --out: approximate, at no more cost");
     solve.add_option("--problems", command.problems,
                      "instanced: CSV of every local problem solved: depth, triangles, closed "
                      "instances, elements, links, seconds");
@@ -80,6 +85,7 @@ Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene*
     options.hrc.directionalInstances = !command.singleValue;
     options.holdOutside = !command.perBin;
     options.maxDepth = command.maxDepth;
+    options.pushDown = command.pushDown;
     options.inView = command.inView;
     if (!command.outputLevel.empty()) {
         options.outputLevel = command.outputLevel == "plant"  ? NodeType::kPlant

@@ -40,8 +40,12 @@ Solution Solve(const PreparedScene& prepared, const SolverSettings& settings) {
             std::optional<PhaseDatabase> own;
             PhaseDatabase* database = instanced.database;
             if (database == nullptr) database = &own.emplace(PhaseDatabaseOptions{});
-            InstancedOptions options{
-                settings.hrc, instanced.originals, instanced.maxDepth, instanced.outputLevel, {}};
+            InstancedOptions options;
+            options.hrc = settings.hrc;
+            options.originals = instanced.originals;
+            options.maxDepth = instanced.maxDepth;
+            options.outputLevel = instanced.outputLevel;
+            options.pushDown = instanced.pushDown;
             options.holdOutside = instanced.holdOutside;
             InstancedSolution solved =
                 SolveInstanced(prepared.Source(), prepared.Flat(),

@@ -24,6 +24,7 @@ struct InstancedSettings {
     bool shadowsByGeometry = true;
     int maxDepth = 0;                     // InstancedOptions::maxDepth
     std::optional<NodeType> outputLevel;  // InstancedOptions::outputLevel
+    bool pushDown = false;                // InstancedOptions::pushDown
     bool holdOutside = true;              // InstancedOptions::holdOutside
     // Filled by the solve when not null: its instances, local problems and originals.
     InstancedStats* stats = nullptr;

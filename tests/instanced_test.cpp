@@ -281,6 +281,80 @@ TEST(Instanced, APlantSolvedWholeAbsorbsWhatItsLeavesDo) {
     EXPECT_EQ(plants, 4 * 2);  // four plants, two bands
 }
 
+// Handed down from the plants solved whole (InstancedOptions::pushDown), every leaf has
+// light, and the leaves of a plant absorb together at least what the plant does (more where
+// the light straight from its box's sides already makes them). Against the leaves of the
+// flattened scene (HRC), their mean irradiance on each side is printed; the structures' CSV
+// is the same as without it (the plants' own light, not their leaves').
+TEST(Instanced, PlantsSolvedWholeHandTheirLightDownToTheirLeaves) {
+    const Scene scene = Copies(4, 120);
+    const PreparedScene prepared(scene);
+    const Solution hrc = Hrc(prepared, 1e-4);
+    PhaseDatabase database({});
+    InstancedOptions options;
+    options.hrc.epsilon = 1e-4;
+    options.outputLevel = NodeType::kPlant;
+    options.pushDown = true;
+    const Solution solution =
+        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options)
+            .solution;
+    ASSERT_EQ(solution.wholeStructures.size(), 4u);
+    testing::ExpectFiniteLight(solution);
+    const FlatScene& flat = prepared.Flat();
+    ASSERT_EQ(solution.pushedDown.size(), flat.receivers.size());
+    std::unordered_map<NodeId, NodeId> parentOf;
+    for (const Node& node : scene.nodes) parentOf.emplace(node.id, node.parent);
+    std::unordered_map<NodeId, std::vector<double>> absorbed;  // by plant, band
+    double sums[2][2][2] = {};                                 // [pushed or hrc][band][side]
+    double area = 0.0;
+    for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
+        const Receiver& receiver = flat.receivers[r];
+        if (receiver.kind != ReceiverKind::kOrgan) continue;
+        EXPECT_EQ(solution.pushedDown[r], 1);
+        EXPECT_EQ(solution.unsolved[r], 0);
+        NodeId plant = receiver.node;
+        while (parentOf.at(plant) != kNoParent) plant = parentOf.at(plant);
+        std::vector<double>& sum = absorbed[plant];
+        sum.resize(scene.bands.size());
+        area += receiver.areaM2;
+        for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+            const BandLight& pushed = solution.light[r][b];
+            sum[b] += pushed.absorbedW;
+            sums[0][b][0] += receiver.areaM2 * pushed.irradianceUpperWm2;
+            sums[0][b][1] += receiver.areaM2 * pushed.irradianceLowerWm2;
+            sums[1][b][0] += receiver.areaM2 * hrc.light[r][b].irradianceUpperWm2;
+            sums[1][b][1] += receiver.areaM2 * hrc.light[r][b].irradianceLowerWm2;
+        }
+    }
+    for (const StructureLight& whole : solution.wholeStructures) {
+        for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+            EXPECT_GE(absorbed.at(whole.node)[b], (1.0 - 1e-9) * whole.bands[b].absorbedW)
+                << whole.name << " band " << b;
+            std::printf("%s band %zu: its leaves absorb %.2f W, the plant solved whole %.2f W\n",
+                        whole.name.c_str(), b, absorbed.at(whole.node)[b],
+                        whole.bands[b].absorbedW);
+        }
+    }
+    for (int b = 0; b < 2; ++b) {
+        std::printf(
+            "band %d: mean irradiance handed down %.2f / %.2f W/m² (upper / lower), "
+            "HRC's leaves %.2f / %.2f\n",
+            b, sums[0][b][0] / area, sums[0][b][1] / area, sums[1][b][0] / area,
+            sums[1][b][1] / area);
+    }
+    // The structures' CSV: the plants as solved whole, their leaves not counted again.
+    std::unordered_map<NodeId, double> whole;
+    for (const StructureLight& s : solution.wholeStructures) whole[s.node] = s.bands[0].absorbedW;
+    int plants = 0;
+    for (const StructureLight& s : AggregateStructures(scene, flat, solution)) {
+        if (s.type != NodeType::kPlant) continue;
+        ++plants;
+        EXPECT_DOUBLE_EQ(s.bands[0].absorbedW, whole.at(s.node));
+        EXPECT_TRUE(std::isnan(s.bands[0].irradianceUpperWm2));
+    }
+    EXPECT_EQ(plants, 4);
+}
+
 // Light per axis where the policy instantiates the plants alone: a plant holds axes that
 // are no instances, so it opens and they are solved, leaf by leaf; nothing below it is an
 // instance, so the light is the light asked per leaf, to the last digit. Left closed as a

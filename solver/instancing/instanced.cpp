@@ -13,6 +13,7 @@
 
 #include "solver/instancing/instance_tree.h"
 #include "solver/instancing/original.h"
+#include "solver/instancing/push_down.h"
 #include "solver/instancing/scene_originals.h"
 #include "solver/instancing/signature.h"
 #include "solver/raytrace/occlusion.h"
@@ -81,6 +82,7 @@ class InstancedSolve {
         out_.solution.light.assign(receivers.receivers.size(), scene.bands.size());
         out_.solution.balance.assign(scene.bands.size(), EnergyBalance{});
         out_.solution.unsolved.assign(receivers.receivers.size(), 0);
+        if (options_.pushDown) out_.solution.pushedDown.assign(receivers.receivers.size(), 0);
         out_.stats.depths.assign(tree.Depth() + 1, InstancedStats::Depth{});
         for (const InstanceTree::Part& part : tree.Parts())
             ++out_.stats.depths[part.depth].instances;
@@ -195,8 +197,13 @@ class InstancedSolve {
     // Where the organs of part q and of the parts in it lie in the shadow engine
     // (ClosedNode::shadowTriangles).
     void ShadowTriangles(std::uint32_t q, ClosedNode& closed) const;
-    // Marks the organs of part q and of the parts in it unsolved; their count and area.
+    // Counts the organs of part q and of the parts in it, and their area, into `whole`;
+    // marks them unsolved, or pushed down (InstancedOptions::pushDown).
     void MarkUnsolved(std::uint32_t q, StructureLight& whole);
+    // The light of part q, closed as `closed` and solved whole into `whole` from
+    // `arrivals`, handed down to its organs (push_down.h).
+    void PushDownInto(std::uint32_t q, const ClosedNode& closed, std::span<const Arrival> arrivals,
+                      const StructureLight& whole);
     void Open(const Level& parent, std::size_t c, std::vector<DirectionalSource> sources,
               std::shared_ptr<const HeldOutside> held, std::size_t heldSelf);
 
@@ -593,11 +600,48 @@ void InstancedSolve::MarkUnsolved(std::uint32_t q, StructureLight& whole) {
     for (std::size_t i : tree_[q].nodes) {
         const std::uint32_t global = OrganReceiver(scene_.nodes[i].id);
         if (global == kNoReceiver) continue;
-        out_.solution.unsolved[global] = 1;
+        (options_.pushDown ? out_.solution.pushedDown : out_.solution.unsolved)[global] = 1;
         ++whole.organCount;
         whole.areaM2 += receivers_.receivers[global].areaM2;
     }
     for (std::uint32_t inner : tree_[q].instances) MarkUnsolved(inner, whole);
+}
+
+void InstancedSolve::PushDownInto(std::uint32_t q, const ClosedNode& closed,
+                                  std::span<const Arrival> arrivals, const StructureLight& whole) {
+    // Its organs in its own frame: its nodes and those of the parts in it, the root at the
+    // origin.
+    std::vector<std::size_t> nodes;
+    std::vector<std::uint32_t> parts{q};
+    while (!parts.empty()) {
+        const InstanceTree::Part& part = tree_[parts.back()];
+        parts.pop_back();
+        nodes.insert(nodes.end(), part.nodes.begin(), part.nodes.end());
+        parts.insert(parts.end(), part.instances.begin(), part.instances.end());
+    }
+    std::sort(nodes.begin(), nodes.end());  // scene order: parents first
+    Scene own;
+    own.bands = scene_.bands;
+    own.optics = scene_.optics;
+    own.nodes.reserve(nodes.size());
+    for (std::size_t i : nodes) {
+        Node node = scene_.nodes[i];
+        if (i == tree_[q].rootIndex) {
+            node.parent = kNoParent;
+            node.parentFromLocal = glm::dmat4(1.0);
+        }
+        own.nodes.push_back(std::move(node));
+    }
+    const FlatScene organs = Flatten(own);
+    const Original& original = *originals_.bySignature.at(tree_[q].signature);
+    const auto tau = [&](const glm::dvec3& in) { return original.transmittance.Value(in, 0); };
+    const std::vector<std::vector<BandLight>> light =
+        PushDown(organs, closed, tau, arrivals, whole.bands, scene_.optics);
+    for (std::size_t r = 0; r < organs.receivers.size(); ++r) {
+        const std::uint32_t global = OrganReceiver(organs.receivers[r].node);
+        if (global == kNoReceiver) continue;
+        std::copy(light[r].begin(), light[r].end(), out_.solution.light[global].begin());
+    }
 }
 
 void InstancedSolve::SolveWhole(const Level& level, const LevelSolution& light, std::size_t c) {
@@ -619,8 +663,10 @@ void InstancedSolve::SolveWhole(const Level& level, const LevelSolution& light, 
     // Irradiance e (W/m² normal to ω) arriving from unit ω (world, towards the source); from
     // a sun or sky cone, light incident on the scene, counted in the balance.
     std::vector<double> incident(channels, 0.0);
+    std::vector<Arrival> arrivals;
     const auto arrive = [&](const glm::dvec3& omega, const double* e, bool fromSource) {
         const glm::dvec3 in = closed.ToInstance(omega);
+        if (options_.pushDown) arrivals.push_back({in, std::vector<double>(e, e + channels)});
         const glm::dvec3 a = glm::abs(in);
         const double section =
             a.x * extent.y * extent.z + a.y * extent.x * extent.z + a.z * extent.x * extent.y;
@@ -647,6 +693,7 @@ void InstancedSolve::SolveWhole(const Level& level, const LevelSolution& light, 
     }
     for (int d = 0; d < light.bins; ++d)
         arrive(directions_.Direction(d), light.arrivedBins[c].data() + d * channels, false);
+    if (options_.pushDown) PushDownInto(q, closed, arrivals, whole);
     std::lock_guard lock(statsMutex_);
     for (int k = 0; k < channels; ++k) {
         out_.solution.balance[k].absorbedW += whole.bands[k].absorbedW;
@@ -701,7 +748,10 @@ InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& receivers,
     // order the threads solved them in.
     std::sort(out.solution.wholeStructures.begin(), out.solution.wholeStructures.end(),
               [](const StructureLight& a, const StructureLight& b) { return a.node < b.node; });
-    if (out.solution.wholeStructures.empty()) out.solution.unsolved.clear();
+    if (out.solution.wholeStructures.empty()) {
+        out.solution.unsolved.clear();
+        out.solution.pushedDown.clear();
+    }
     std::sort(out.stats.problems.begin(), out.stats.problems.end(),
               [](const InstancedStats::Problem& a, const InstancedStats::Problem& b) {
                   return std::tie(a.depth, a.triangles, a.elements, a.links) <

@@ -67,6 +67,10 @@ struct InstancedOptions {
     // is that of the light arriving on its box; its leaves' irradiances are not solved.
     int maxDepth = 0;
     std::optional<NodeType> outputLevel;
+    // A structure solved whole hands its light down to its organs (push_down.h), which are
+    // then in the organ results, marked Solution::pushedDown: approximate. Off, they are
+    // left out (Solution::unsolved).
+    bool pushDown = false;
     // When set, an instance opens only if this accepts its box in the world (the bounds of
     // its box's corners): a picture opens only the instances in view (Soler 2003 §7.1,
     // leaflux render). The others are solved whole, as beyond maxDepth.

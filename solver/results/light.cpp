@@ -62,6 +62,8 @@ std::vector<StructureLight> AggregateStructures(const Scene& scene, const FlatSc
         const Receiver& receiver = flat.receivers[r];
         if (receiver.kind != ReceiverKind::kOrgan) continue;
         if (!solution.unsolved.empty() && solution.unsolved[r]) continue;
+        // Light handed down from a structure solved whole: that structure's already.
+        if (!solution.pushedDown.empty() && solution.pushedDown[r]) continue;
         for (NodeId at = receiver.node; at != kNoParent; at = byId.at(at)->parent)
             add(sums[at], 1, receiver.areaM2, solution.light[r], solution.ErrorOf(r));
     }

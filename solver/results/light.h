@@ -180,6 +180,9 @@ struct Solution {
     // and left out of the organ results. Both empty for the other solvers.
     std::vector<StructureLight> wholeStructures;
     std::vector<std::uint8_t> unsolved;
+    // Organs whose light a structure solved whole handed down (InstancedOptions::pushDown):
+    // approximate (push_down.h); 1 by receiver, empty when there are none.
+    std::vector<std::uint8_t> pushedDown;
     std::vector<EnergyBalance> balance;  // [band]
     SolveStats stats;
     std::vector<LinkAudit> linkAudit;  // HRC with auditLinks only
