@@ -65,7 +65,7 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
                    "instanced: with --max-depth or --output-level, the leaves of the structures "
                    "solved whole get light handed down from the structure's (straight light "
                    "from its box's sides through its transmittance, what it absorbs beyond that "
-                   "evenly), in --out: approximate, at no more cost");
+                   "evenly), in --out: approximate, for a little more time");
     solve.add_option("--problems", command.problems,
                      "instanced: CSV of every local problem solved: depth, triangles, closed "
                      "instances, elements, links, seconds");

@@ -118,6 +118,7 @@ InstancedRun InstancedRunFromProto(const v1::InstancedSettings& in, const std::s
     }
     run.singleValue = in.single_value();
     run.options.holdOutside = !in.per_bin();
+    run.options.pushDown = in.push_down();
     switch (in.shadows()) {
         case v1::INSTANCED_SHADOWS_UNSPECIFIED:
         case v1::INSTANCED_SHADOWS_GEOMETRY:

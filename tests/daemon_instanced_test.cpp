@@ -108,16 +108,20 @@ v1::CycleResult RunCycle(Daemon& daemon, const std::string& session, std::int64_
 // session's settings, on `database`: organ light by node. A function is kept by its
 // signature, computed from the structure that first had it: the same scene gets the same
 // light from the same database.
+// The options a session of Instanced() solves with.
+InstancedOptions AloneOptions() {
+    InstancedOptions options;
+    options.hrc.epsilon = 1e-3;
+    return options;
+}
+
 std::map<std::uint64_t, BandLight> SolvedAlone(const v1::Scene& message, PhaseDatabase& database,
-                                               bool holdOutside = true) {
+                                               const InstancedOptions& options = AloneOptions()) {
     const Scene scene = FromProto(message, "", {});
     const PreparedScene prepared(scene);
     InstancingPolicy policy = DefaultPolicy();
     policy.species = kSpecies;
     policy.phase = {PhaseKind::kMonoDirectional, 2};
-    InstancedOptions options;
-    options.hrc.epsilon = 1e-3;
-    options.holdOutside = holdOutside;
     const InstancedSolution solved =
         SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), policy, database, options);
     std::map<std::uint64_t, BandLight> light;
@@ -216,14 +220,33 @@ TEST(DaemonInstanced, APerBinSessionGetsTheLightOfAPerBinSolve) {
     v1::SolverSettings settings = Instanced();
     settings.mutable_instanced()->set_per_bin(true);
     const v1::CycleResult result = RunCycle(daemon, Open(daemon, scene, settings), 1);
-    ExpectSameLight(result, SolvedAlone(scene, daemon.PhaseFunctions(), false), 1);
-    const auto held = SolvedAlone(scene, daemon.PhaseFunctions(), true);
+    InstancedOptions perBin = AloneOptions();
+    perBin.holdOutside = false;
+    ExpectSameLight(result, SolvedAlone(scene, daemon.PhaseFunctions(), perBin), 1);
+    const auto held = SolvedAlone(scene, daemon.PhaseFunctions());
     double largest = 0.0;
     for (const v1::OrganLight& organ : result.organs()) {
         largest = std::max(largest, std::abs(organ.bands(0).irradiance_lower_wm2() -
                                              held.at(organ.node()).irradianceLowerWm2));
     }
     EXPECT_GT(largest, 1e-3);  // the field changed the solve
+}
+
+// `push_down` with `output_level`: every organ of the plants solved whole is in the reply,
+// with the light `leaflux solve --output-level plant --push-down` hands down to it.
+TEST(DaemonInstanced, APushDownSessionGetsTheLightHandedDownToEveryOrgan) {
+    Daemon daemon;
+    const v1::Scene scene = InlineProto(Trees());
+    v1::SolverSettings settings = Instanced();
+    settings.mutable_instanced()->set_output_level(v1::NODE_TYPE_PLANT);
+    settings.mutable_instanced()->set_push_down(true);
+    const v1::CycleResult result = RunCycle(daemon, Open(daemon, scene, settings), 1);
+    InstancedOptions pushed = AloneOptions();
+    pushed.outputLevel = NodeType::kPlant;
+    pushed.pushDown = true;
+    const auto want = SolvedAlone(scene, daemon.PhaseFunctions(), pushed);
+    ExpectSameLight(result, want, 1);
+    EXPECT_GT(result.organs_size(), 0);
 }
 
 std::filesystem::path TempFile(const std::string& name) {

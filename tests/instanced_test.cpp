@@ -221,6 +221,17 @@ TEST(Instanced, OpeningOnlyTheCopiesInViewLeavesTheirLightAsItWas) {
     EXPECT_EQ(solved, unsolved);  // two copies of four
 }
 
+// The plants of `scene` solved whole (ε = 1e-4), their light handed down or not.
+InstancedSolution PlantsSolvedWhole(const Scene& scene, const PreparedScene& prepared,
+                                    bool pushDown) {
+    PhaseDatabase database({});
+    InstancedOptions options;
+    options.hrc.epsilon = 1e-4;
+    options.outputLevel = NodeType::kPlant;
+    options.pushDown = pushDown;
+    return SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+}
+
 // Light per plant, the plants never opened (outputLevel): each copy's absorbed power is
 // what its phase function and transmittance make of the light that arrived on its box, and
 // that is what its leaves absorb in the flattened scene's HRC.
@@ -228,12 +239,7 @@ TEST(Instanced, APlantSolvedWholeAbsorbsWhatItsLeavesDo) {
     const Scene scene = Copies(4, 120);
     const PreparedScene prepared(scene);
     const Solution hrc = Hrc(prepared, 1e-4);
-    PhaseDatabase database({});
-    InstancedOptions options;
-    options.hrc.epsilon = 1e-4;
-    options.outputLevel = NodeType::kPlant;
-    const InstancedSolution instanced =
-        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+    const InstancedSolution instanced = PlantsSolvedWhole(scene, prepared, false);
     EXPECT_EQ(instanced.stats.depths[1].opened, 0);
     EXPECT_EQ(instanced.stats.depths[1].whole, 4);
     const Solution& solution = instanced.solution;
@@ -290,14 +296,7 @@ TEST(Instanced, PlantsSolvedWholeHandTheirLightDownToTheirLeaves) {
     const Scene scene = Copies(4, 120);
     const PreparedScene prepared(scene);
     const Solution hrc = Hrc(prepared, 1e-4);
-    PhaseDatabase database({});
-    InstancedOptions options;
-    options.hrc.epsilon = 1e-4;
-    options.outputLevel = NodeType::kPlant;
-    options.pushDown = true;
-    const Solution solution =
-        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options)
-            .solution;
+    const Solution solution = PlantsSolvedWhole(scene, prepared, true).solution;
     ASSERT_EQ(solution.wholeStructures.size(), 4u);
     testing::ExpectFiniteLight(solution);
     const FlatScene& flat = prepared.Flat();

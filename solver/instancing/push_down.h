@@ -1,7 +1,7 @@
 // The light of a structure solved whole handed down to its organs (InstancedOptions::
 // pushDown): the "leaf results pushed down from the structure's solution", an
 // approximation, for when opening stops at a depth or a structure type and the leaves'
-// light is still wanted at no more cost.
+// light is still wanted for little more time.
 //
 // A structure solved whole knows the light that arrived on its box, by direction, and what
 // it absorbed of it (its original's absorption, InstancedSolve::SolveWhole). Each organ's
