@@ -397,7 +397,7 @@ def rays_section(build, out, run=True):
 # The daemon's growing trees as scenes (no ground, 46-cone sky: ε relative to the plant's own
 # light) and the ε of its cycles: (name, leaves).
 DAEMON_TREES = [("tree1k_bare", 1000), ("tree10k_bare", 10000)]
-DAEMON_EPSILONS = ["1e-4", "3e-4", "1e-3"]
+DAEMON_EPSILONS = ["1e-4", "3e-4", "1e-3", "3e-3"]
 DAEMON_GOAL_PCT = 2.0  # the L2 error a cycle is asked to stay within, per band
 
 

@@ -36,6 +36,8 @@ std::int64_t ResidentBytes() {
 
 void HandFreedPagesBack() { malloc_trim(0); }
 
+std::size_t FreeHeapBytes() { return mallinfo2().fordblks; }
+
 bool ResetPeakRss() {
     HandFreedPagesBack();  // what earlier runs freed, out of the new peak
     std::ofstream clearRefs("/proc/self/clear_refs");
