@@ -73,6 +73,11 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
 
 Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene* shadows,
                       const HrcOptions& hrc, const InstancedCommand& command) {
+    if (command.pushDown && command.maxDepth == 0 && command.outputLevel.empty()) {
+        throw InputError(ErrorCode::kInvalidArgument, "--push-down",
+                         "needs --max-depth or --output-level: without them no structure is "
+                         "solved whole");
+    }
     const InstancingPolicy policy =
         command.policy.empty() ? DefaultPolicy() : LoadPolicyFile(command.policy);
     PhaseDatabase database(

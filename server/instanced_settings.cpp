@@ -118,6 +118,11 @@ InstancedRun InstancedRunFromProto(const v1::InstancedSettings& in, const std::s
     }
     run.singleValue = in.single_value();
     run.options.holdOutside = !in.per_bin();
+    if (in.push_down() && in.max_depth() == 0 && in.output_level() == v1::NODE_TYPE_UNSPECIFIED) {
+        throw InputError(ErrorCode::kInvalidArgument, std::string(kField) + ".push_down",
+                         "needs max_depth or output_level: without them no structure is "
+                         "solved whole");
+    }
     run.options.pushDown = in.push_down();
     switch (in.shadows()) {
         case v1::INSTANCED_SHADOWS_UNSPECIFIED:

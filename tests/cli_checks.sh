@@ -80,6 +80,10 @@ grep -q "receivers" "$out/last.log" && fail "the scene was read before --out was
 refused "$leaflux" solve --scene "$scene" --out "$out/ok.csv" --structures "$out"
 grep -q -- "--structures" "$out/last.log" || fail "a folder as --structures is not named"
 test ! -e "$out/ok.csv" || fail "--out was written by a solve that could not write --structures"
+# Light handed down asks for structures solved whole: alone it is refused, named.
+refused "$leaflux" solve --scene "$scene" --solver instanced --no-phase-db --out "$out/ok.csv" \
+    --push-down
+grep -q -- "--push-down" "$out/last.log" || fail "--push-down without a stop is not named"
 
 # The solve's CSV: W and µmol columns, PAR's µmol 4.57 times its W.
 "$leaflux" solve --scene "$scene" --quiet --out "$out/deep/er/leaf.csv" > "$out/solve.log"

@@ -365,6 +365,9 @@ TEST(DaemonInstanced, BadInstancedSettingsAreRefusedNamingTheField) {
     both.mutable_instanced()->set_max_depth(1);
     both.mutable_instanced()->set_output_level(v1::NODE_TYPE_AXIS);
     refused(both, "settings.instanced.output_level");
+    v1::SolverSettings pushDown = Instanced();
+    pushDown.mutable_instanced()->set_push_down(true);  // nothing solved whole to hand down
+    refused(pushDown, "settings.instanced.push_down");
     v1::SolverSettings inlinePolicy = Instanced();
     inlinePolicy.mutable_instanced()->mutable_inline_policy()->set_species("x");
     refused(inlinePolicy, "settings.instanced.inline_policy.phase");

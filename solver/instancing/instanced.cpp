@@ -18,6 +18,7 @@
 #include "solver/instancing/signature.h"
 #include "solver/raytrace/occlusion.h"
 #include "solver/scene/geometry.h"
+#include "solver/scene/subtrees.h"
 #include "solver/scene/world_frames.h"
 #include "solver/util/box.h"
 #include "solver/util/check.h"
@@ -241,15 +242,7 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
     } else {
         local.sources.emitters = held ? held->emitters : held_;
     }
-    local.nodes.reserve(part.nodes.size());
-    for (std::size_t i : part.nodes) {
-        Node node = scene_.nodes[i];
-        if (node.id == part.root) {
-            node.parent = kNoParent;
-            node.parentFromLocal = worldFromRoot;
-        }
-        local.nodes.push_back(std::move(node));
-    }
+    local.nodes = Rerooted(scene_, part.nodes, part.root, worldFromRoot);
     level->flat = Flatten(local);
     // Its closed instances where they are in the world.
     const auto worldFromLocal = WorldFromLocal(local);
@@ -623,15 +616,7 @@ void InstancedSolve::PushDownInto(std::uint32_t q, const ClosedNode& closed,
     Scene own;
     own.bands = scene_.bands;
     own.optics = scene_.optics;
-    own.nodes.reserve(nodes.size());
-    for (std::size_t i : nodes) {
-        Node node = scene_.nodes[i];
-        if (i == tree_[q].rootIndex) {
-            node.parent = kNoParent;
-            node.parentFromLocal = glm::dmat4(1.0);
-        }
-        own.nodes.push_back(std::move(node));
-    }
+    own.nodes = Rerooted(scene_, nodes, tree_[q].root, glm::dmat4(1.0));
     const FlatScene organs = Flatten(own);
     const Original& original = *originals_.bySignature.at(tree_[q].signature);
     const auto tau = [&](const glm::dvec3& in) { return original.transmittance.Value(in, 0); };

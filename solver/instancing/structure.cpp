@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "solver/scene/geometry.h"
+#include "solver/scene/subtrees.h"
 #include "solver/scene/topology.h"
 #include "solver/util/error.h"
 
@@ -37,15 +38,11 @@ StructureAlone::StructureAlone(const Scene& scene, NodeId root) {
         const std::span<const std::uint32_t> children = topology.Children(i);
         stack.insert(stack.end(), children.begin(), children.end());
     }
+    std::vector<std::size_t> indices;
     for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
-        if (!inside[i]) continue;
-        Node node = scene.nodes[i];
-        if (i == *rootIndex) {
-            node.parent = kNoParent;
-            node.parentFromLocal = glm::dmat4(1.0);
-        }
-        alone_.nodes.push_back(std::move(node));
+        if (inside[i]) indices.push_back(i);
     }
+    alone_.nodes = Rerooted(scene, indices, root, glm::dmat4(1.0));
     flat_ = Flatten(alone_);
     if (flat_.Empty())
         throw InputError(ErrorCode::kDegenerate, "root", "has no organ under it", root);

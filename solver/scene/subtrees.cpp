@@ -21,4 +21,19 @@ std::unordered_set<NodeId> NodesUnder(const Scene& scene, const std::vector<Node
     return under;
 }
 
+std::vector<Node> Rerooted(const Scene& scene, std::span<const std::size_t> indices, NodeId root,
+                           const glm::dmat4& rootFrame) {
+    std::vector<Node> nodes;
+    nodes.reserve(indices.size());
+    for (std::size_t i : indices) {
+        Node node = scene.nodes[i];
+        if (node.id == root) {
+            node.parent = kNoParent;
+            node.parentFromLocal = rootFrame;
+        }
+        nodes.push_back(std::move(node));
+    }
+    return nodes;
+}
+
 }  // namespace leaflux
