@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -156,12 +157,15 @@ TEST(OpfSkip, StrictRefusesNamingTheNodeAndLine) {
 }
 
 TEST(OpfSkip, TheRestOfThePlantIsLitAndStrictKeepsTheRefusal) {
+    // The scene imports the plant by its name beside it: the test's own file.
     const std::string opf = WriteTempFile("lit.opf", MeasuredPlant());
-    const std::string scenePath = WriteTempFile("lit.scene.txtpb", R"(
+    const std::string scenePath =
+        WriteTempFile("lit.scene.txtpb", R"(
 bands { name: "PAR" }
 optics { id: "bark" bands { key: "PAR" value { rho_upper: 0.1 rho_lower: 0.1 } } }
 optics { id: "leaf" bands { key: "PAR" value { rho_upper: 0.1 rho_lower: 0.1 tau_upper: 0.05 tau_lower: 0.05 } } }
-imports { path: "lit.opf" material_optics { key: "material0" value: "bark" }
+imports { path: ")" + std::filesystem::path(opf).filename().string() +
+                                             R"(" material_optics { key: "material0" value: "bark" }
           material_optics { key: "material1" value: "leaf" } }
 suns { direction { x: 0 y: 0 z: 1 } normal_irradiance { key: "PAR" value: 400 } }
 )");

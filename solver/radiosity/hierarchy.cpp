@@ -382,13 +382,19 @@ Hierarchy::Point Hierarchy::Sample(std::uint32_t index, double u, double v) cons
         const glm::dvec3 w = UniformTriangle(u, v);
         return {w.x * node.a + w.y * node.b + w.z * node.c, node.normal, node.triangle};
     }
-    // An original triangle by area, then a point inside it.
-    const double lo = cumulativeArea_[node.first], hi = cumulativeArea_[node.first + node.count];
-    const double target = lo + u * (hi - lo);
-    auto it = std::upper_bound(cumulativeArea_.begin() + node.first + 1,
-                               cumulativeArea_.begin() + node.first + node.count + 1, target);
-    if (it == cumulativeArea_.begin() + node.first + node.count + 1) --it;
-    const std::size_t k = static_cast<std::size_t>(it - cumulativeArea_.begin()) - 1;
+    // An original triangle by area, then a point inside it: the first whose end passes the
+    // target, the last where rounding leaves none. The search has no branch to mispredict
+    // (Khuong and Morin's): sampling points on clusters took an eighth of a daemon cycle.
+    const double* ends = cumulativeArea_.data() + node.first + 1;
+    const double target = cumulativeArea_[node.first] + u * (ends[node.count - 1] - ends[-1]);
+    const double* at = ends;
+    for (std::size_t n = node.count - 1; n > 1;) {
+        const std::size_t half = n / 2;
+        at = at[half] <= target ? at + half : at;
+        n -= half;
+    }
+    if (node.count > 1 && *at <= target) ++at;
+    const std::size_t k = node.first + static_cast<std::size_t>(at - ends);
     u = std::clamp((target - cumulativeArea_[k]) / (cumulativeArea_[k + 1] - cumulativeArea_[k]),
                    0.0, 1.0);
     if (triangleOrder_[k] & kClosedEntry)
