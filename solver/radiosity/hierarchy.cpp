@@ -384,7 +384,7 @@ Hierarchy::Point Hierarchy::Sample(std::uint32_t index, double u, double v) cons
     }
     // An original triangle by area, then a point inside it: the first whose end passes the
     // target, the last where rounding leaves none. The search has no branch to mispredict
-    // (Khuong and Morin's): sampling points on clusters took an eighth of a daemon cycle.
+    // (Khuong and Morin's): the same points, the 1k and 119k trees' solves 2–3 % faster.
     const double* ends = cumulativeArea_.data() + node.first + 1;
     const double target = cumulativeArea_[node.first] + u * (ends[node.count - 1] - ends[-1]);
     const double* at = ends;
