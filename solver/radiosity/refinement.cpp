@@ -217,11 +217,12 @@ Refiner::Verdict Refiner::JudgePair(std::uint32_t r, std::uint32_t s) const {
         return verdict;
     }
     // Organs among the leaves of a closed instance held from outside: split down to half
-    // its radius, then its light from all around them (HeldAroundLinks).
+    // its radius, then its light from all around them (HeldAroundLinks), and further while
+    // that light is more than the threshold (HeldAroundLight).
     if (const ClosedNode* held = model_.Closed(s);
         held != nullptr && held->Held() && BoundsOverlap(hierarchy_[r], hierarchy_[s])) {
-        if (hierarchy_[r].radius > 0.5 * hierarchy_[s].radius && CanSplit(r))
-            return Verdict::Of(Verdict::kSplitReceiver);
+        const double ratio = hierarchy_[r].radius / hierarchy_[s].radius;
+        if (ratio > kHeldAroundCoarsest && CanSplit(r)) return Verdict::Of(Verdict::kSplitReceiver);
         Verdict verdict;
         verdict.links = HeldAroundLinks(
             model_, r, s,
@@ -229,6 +230,12 @@ Refiner::Verdict Refiner::JudgePair(std::uint32_t r, std::uint32_t s) const {
                 return visibility_.HeldTransmittance(p, direction, length, held);
             },
             verdict.rays);
+        if (ratio > kHeldAroundFinest && CanSplit(r) &&
+            HeldAroundLight(r, s, verdict.links) > Threshold(r)) {
+            verdict.links.clear();
+            verdict.kind = Verdict::kSplitReceiver;
+            return verdict;
+        }
         if (!verdict.links.empty()) verdict.kind = Verdict::kLink;
         return verdict;
     }
@@ -285,6 +292,21 @@ Refiner::Verdict Refiner::JudgePair(std::uint32_t r, std::uint32_t s) const {
         SetTransfer(link, e, sight.visibility);
     }
     return verdict;
+}
+
+double Refiner::HeldAroundLight(std::uint32_t r, std::uint32_t s,
+                                const std::vector<NodeLink>& links) const {
+    const double* intensity = field_.intensity[model_.Slot(s)];
+    const int channels = model_.ChannelSet().Count();
+    double power = 0.0;
+    for (const NodeLink& link : links) {
+        const double* sent = intensity + link.senderBins.index[0] * channels;
+        double light = 0.0;
+        for (int k = 0; k < channels; ++k) light += sent[k];
+        power += static_cast<double>(link.transfer[0]) * light *
+                 model_.ProjectedArea(r, glm::dvec3(link.toSender));
+    }
+    return power;
 }
 
 void Refiner::SetTransfer(NodeLink& link, const Estimate& e, double v) const {
