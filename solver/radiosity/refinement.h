@@ -95,11 +95,11 @@ class Refiner {
     // (HeldAroundLinks), all channels: such a link hands every part of r the light the
     // held instance sends where r's points are, which varies across r as the depth of
     // its organs behind each point does, so r is split while that light exceeds the
-    // threshold. Down to half the held instance's radius only, the 119k-leaf tree's leaves
-    // got 8–11 % too little scattered NIR on their upper sides, and its NIR L2 error was
-    // 2.04 % at ε = 1e-4; split further so, 1.94 %, and the 10,000-leaf tree's at 3e-4
-    // 1.49 % instead of 1.60, each for 3 % more time; at 3e-3 the 1,000-leaf tree is
-    // solved as it was (leaflux solve against a Monte Carlo reference; interleaved runs).
+    // threshold. Split down to half the held instance's radius only, the 119k-leaf tree's
+    // NIR L2 error was 2.04 % at ε = 1e-4 (the leaves' upper sides short of scattered
+    // light); split further so, 1.94 %, and the 10,000-leaf tree's at 3e-4 1.49 % instead
+    // of 1.60, each for 3 % more time; at 3e-3 the 1,000-leaf tree is solved as it was
+    // (leaflux bench error, docs/results.md; times from interleaved runs).
     double HeldAroundLight(std::uint32_t r, std::uint32_t s,
                            const std::vector<NodeLink>& links) const;
     static constexpr double kHeldAroundCoarsest = 0.5, kHeldAroundFinest = 0.125;
