@@ -106,6 +106,15 @@ TEST(Instanced, WithoutInstancesItIsHrc) {
     }
 }
 
+// `scene` instantiated at its plants at ε, from an empty phase-function database.
+InstancedSolution PlantsInstanced(const Scene& scene, const PreparedScene& prepared,
+                                  double epsilon) {
+    PhaseDatabase database({});
+    InstancedOptions options;
+    options.hrc.epsilon = epsilon;
+    return SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+}
+
 // Four copies of a 120-leaf tree, 1.2 m apart and each turned, shading and lighting one
 // another: instantiated at the copies, their leaves get what the flattened scene's HRC
 // gives them, within what instancing approximates — the light each copy sends the others
@@ -116,11 +125,7 @@ TEST(Instanced, ExactCopiesLightTheirLeavesAsTheFlattenedScene) {
     const Scene scene = Copies(4, 120);
     const PreparedScene prepared(scene);
     const Solution hrc = Hrc(prepared, 1e-4);
-    PhaseDatabase database({});
-    InstancedOptions options;
-    options.hrc.epsilon = 1e-4;
-    const InstancedSolution instanced =
-        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+    const InstancedSolution instanced = PlantsInstanced(scene, prepared, 1e-4);
     EXPECT_EQ(instanced.stats.originalsComputed, 1);  // one original for the four
     ASSERT_EQ(instanced.stats.depths.size(), 2u);
     EXPECT_EQ(instanced.stats.depths[1].instances, 4);
@@ -540,11 +545,7 @@ TEST(Instanced, OrgansAmongAHeldCrownTakeItsLightSideBySide) {
     const Scene scene = Copies(3, 300, 0.3);
     const PreparedScene prepared(scene);
     const Solution hrc = Hrc(prepared, 1e-5);
-    PhaseDatabase database({});
-    InstancedOptions options;
-    options.hrc.epsilon = 1e-4;
-    const InstancedSolution instanced =
-        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), Plants(), database, options);
+    const InstancedSolution instanced = PlantsInstanced(scene, prepared, 1e-4);
     constexpr int kNir = 1;
     double squares = 0.0, brightest = 0.0;
     int sides = 0;
