@@ -57,10 +57,12 @@ void NodeModel::FindOrgans() {
     }
     organs_.assign(hierarchy_.Size(), 0);
     held_.assign(hierarchy_.Size(), 0);
+    emitters_.assign(hierarchy_.Size(), 0);
     for (std::uint32_t n = 0; n < hierarchy_.Size(); ++n) {
         const HrcNode& node = hierarchy_[n];
         if (node.patch) {
             organs_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kOrgan;
+            emitters_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kEmitter;
             held_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kHeld ? kAllHeld : 0;
         } else if (node.closed >= 0) {
             const bool held = hierarchy_.Closed()[node.closed].Held();
@@ -70,6 +72,7 @@ void NodeModel::FindOrgans() {
             bool all = !node.children.empty(), any = false;
             for (std::uint32_t child : node.children) {
                 organs_[n] |= organs_[child];
+                emitters_[n] |= emitters_[child];
                 all = all && held_[child] == kAllHeld;
                 any = any || held_[child] != 0;
             }

@@ -69,6 +69,14 @@ class NodeModel {
         return node.patch ? flat_.receivers[node.receiver].kind == ReceiverKind::kHeld
                           : held_[n] == kAllHeld;
     }
+    // n holds an emitter or what is held from outside a local problem: light not scattered
+    // by the surfaces solved with it, which may be all some organs get.
+    bool FirstHand(std::uint32_t n) const {
+        const HrcNode& node = hierarchy_[n];
+        if (!node.patch) return held_[n] != 0 || emitters_[n] != 0;
+        const ReceiverKind kind = flat_.receivers[node.receiver].kind;
+        return kind == ReceiverKind::kEmitter || kind == ReceiverKind::kHeld;
+    }
     // n is a cluster holding both: what lands on it would reach held parts, which receive
     // nothing, and its points may be theirs. It is split before anything links to it.
     bool PartlyHeld(std::uint32_t n) const {
@@ -197,9 +205,10 @@ class NodeModel {
     std::vector<std::uint8_t> lamps_;   // by node as built: Lamp
     std::vector<std::uint8_t> organs_;  // by node as built: 1 over an organ
     static constexpr std::uint8_t kPartlyHeld = 1, kAllHeld = 2;
-    std::vector<std::uint8_t> held_;    // by node as built: Held, PartlyHeld
-    std::vector<std::uint8_t> planes_;  // by node as built: Planar
-    std::vector<std::uint32_t> slot_;   // by node: clusters' slots, kNoNode for patches
+    std::vector<std::uint8_t> held_;      // by node as built: Held, PartlyHeld
+    std::vector<std::uint8_t> emitters_;  // by node as built: an emitter under it
+    std::vector<std::uint8_t> planes_;    // by node as built: Planar
+    std::vector<std::uint32_t> slot_;     // by node: clusters' slots, kNoNode for patches
     std::uint32_t slots_ = 0;
     std::vector<double> projected_;  // [slot][bin]
 };

@@ -257,7 +257,17 @@ Refiner::Verdict Refiner::JudgePair(std::uint32_t r, std::uint32_t s) const {
     }
     Verdict verdict;
     const double unoccluded = exact ? e.form.upper + e.form.lower : 0.0;
-    const Sight sight = visibility_.Between(r, s, RaySet::kJudging, verdict.rays);
+    // Scattered light, half the rays first: where their spread already leaves the link
+    // within ε, the rest would not change the verdict, and its visibility is theirs.
+    LinkRays tally;
+    Sight sight =
+        visibility_.Between(r, s, RaySet::kJudging, verdict.rays, tally,
+                            model_.FirstHand(s) ? visibility_.VisibilityRays()
+                                                : LinkRays::First(visibility_.VisibilityRays()));
+    if (e.Error(sight.spread) > threshold) {
+        sight = visibility_.Between(r, s, RaySet::kJudging, verdict.rays, tally,
+                                    visibility_.VisibilityRays());
+    }
     if (e.Error(sight.spread) > threshold) {
         if (const auto split = SplitChoice(r, s); split != Verdict::kNone) {
             verdict.kind = split;

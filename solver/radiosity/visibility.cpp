@@ -26,21 +26,54 @@ struct Exclusion {
 };
 
 // Where a link's rays start and end: the points of one rank-1 lattice, shifted apart for
-// each end, the sender's taken in the order of its strata (RandomStrata) so that no point
-// of one end is always paired with the same point of the other.
+// each end. The even points come first (LinkRays::First), a lattice of half as many, then
+// the odd ones; within each half the sender's points are paired with the receiver's in a
+// random order (RandomStrata), so that no point of one end is always paired with the same
+// point of the other.
 class EndPoints {
   public:
     EndPoints(Random& random, const RankOneLattice& lattice)
         : lattice_(lattice),
+          first_(LinkRays::First(lattice.Count())),
           receiver_(random.Uniform(), random.Uniform()),
-          sender_(random.Uniform(), random.Uniform()) {}
-    glm::dvec2 Receiver(int i) const { return lattice_.Point(i, receiver_); }
-    glm::dvec2 Sender(int i) const { return lattice_.Point(i, sender_); }
+          sender_(random.Uniform(), random.Uniform()) {
+        RandomStrata(random, order_[0], first_);
+        RandomStrata(random, order_[1], lattice.Count() - first_);
+    }
+    // The points of the link's ray i.
+    glm::dvec2 Receiver(int i) const { return lattice_.Point(Point(i), receiver_); }
+    glm::dvec2 Sender(int i) const {
+        const bool second = i >= first_;
+        const int base = second ? first_ : 0;
+        return lattice_.Point(Point(base + order_[second][i - base]), sender_);
+    }
 
   private:
+    // The lattice's point at position `at` of the rays' order.
+    int Point(int at) const {
+        if (first_ == lattice_.Count()) return at;
+        return at < first_ ? 2 * at : 2 * (at - first_) + 1;
+    }
     const RankOneLattice& lattice_;
+    const int first_;
     const glm::dvec2 receiver_, sender_;
+    // One thread's rays are traced one link at a time.
+    static thread_local std::vector<int> order_[2];
 };
+thread_local std::vector<int> EndPoints::order_[2];
+
+// What the rays of `tally` show; the visibility `unseen` where none was traced.
+Sight Seen(const LinkRays& tally, double unseen) {
+    Sight sight;
+    sight.spread =
+        VisibilitySpread(tally.traced > 0 ? tally.passed / tally.traced : 1.0, tally.taken);
+    if (tally.totalLight > 0.0) {
+        sight.visibility = tally.visibleLight / tally.totalLight;
+    } else {
+        sight.visibility = tally.total > 0.0 ? tally.visible / tally.total : unseen;
+    }
+    return sight;
+}
 }  // namespace
 
 std::vector<int> SourceRayCounts(std::span<const DirectionalSource> sources,
@@ -129,20 +162,16 @@ double LinkVisibility::Passed(const Hierarchy::Point& p, std::int32_t closedEnd,
 }
 
 Sight LinkVisibility::BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet set,
-                                     std::int64_t& rays) const {
+                                     std::int64_t& rays, LinkRays& tally, int upTo) const {
     Random random(StreamSeed(static_cast<std::uint64_t>(set), r, s));
-    const int count = visibilityRays_;
-    thread_local std::vector<int> strata;  // the sender's, in a random order
-    RandomStrata(random, strata, count);
     const HrcNode& S = hierarchy_[s];
     const bool held = model_.Held(s);
     const EndPoints ends(random, visibilityLattice_);
-    double seen = 0.0, total = 0.0, passed = 0.0;
-    int traced = 0;
-    for (int i = 0; i < count; ++i) {
+    for (; tally.taken < upTo; ++tally.taken) {
+        const int i = tally.taken;
         const glm::dvec2 at = ends.Receiver(i);
         const Hierarchy::Point p = hierarchy_.Sample(r, at.x, at.y);
-        const auto [u, v] = ends.Sender(strata[i]);
+        const auto [u, v] = ends.Sender(i);
         // Each ray weighted by its estimate of π F(x → S): where S is near (its radius
         // more than kNear of its distance), Ω |n · ω| for a direction uniform in S's solid
         // angle Ω; farther, A_S |n · ω| |cos θy| / d² to a point uniform on S, that kernel
@@ -173,38 +202,32 @@ Sight LinkVisibility::BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet se
         // of S's radius of that plane: a ray grazing it from a point by its edge (a corner
         // of a room) would meet S's coplanar neighbours there, by rounding alone.
         length -= std::max(1e-4 * length, 1e-4 * S.radius / std::abs(glm::dot(omega, S.normal)));
-        ++rays, ++traced;
-        total += weight;
-        if (length <= 0.0) {
-            seen += weight;
-            passed += 1.0;
-            continue;
-        }
-        const double through = Passed(p, -1, omega, length, held);
-        seen += weight * through;
-        passed += through;
+        ++rays, ++tally.traced;
+        tally.total += weight;
+        const double through = length > 0.0 ? Passed(p, -1, omega, length, held) : 1.0;
+        tally.visible += weight * through;
+        tally.passed += through;
     }
-    Sight sight;
-    sight.spread = VisibilitySpread(traced > 0 ? passed / traced : 1.0, visibilityRays_);
-    sight.visibility = total > 0.0 ? seen / total : 1.0;
-    return sight;
+    return Seen(tally, 1.0);
 }
 
 Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set,
                               std::int64_t& rays) const {
-    if (hierarchy_[r].patch && hierarchy_[s].patch) return BetweenPatches(r, s, set, rays);
+    LinkRays tally;
+    return Between(r, s, set, rays, tally, visibilityRays_);
+}
+
+Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
+                              LinkRays& tally, int upTo) const {
+    if (hierarchy_[r].patch && hierarchy_[s].patch)
+        return BetweenPatches(r, s, set, rays, tally, upTo);
     Random random(StreamSeed(static_cast<std::uint64_t>(set), r, s));
-    const int count = visibilityRays_;
-    thread_local std::vector<int> strata;  // the sender's, in a random order
-    RandomStrata(random, strata, count);
     const bool fromCluster = !hierarchy_[s].patch;
     const bool held = model_.Held(s);
-    double visible = 0.0, total = 0.0, visibleLight = 0.0, totalLight = 0.0;
-    int traced = 0;
-    double passed = 0.0;
     const EndPoints ends(random, visibilityLattice_);
-    for (int i = 0; i < count; ++i) {
-        const glm::dvec2 at = ends.Receiver(i), from = ends.Sender(strata[i]);
+    for (; tally.taken < upTo; ++tally.taken) {
+        const int i = tally.taken;
+        const glm::dvec2 at = ends.Receiver(i), from = ends.Sender(i);
         const Hierarchy::Point p = hierarchy_.Sample(r, at.x, at.y);
         // Spread over S as well: a cluster's children each get their share of rays.
         const Hierarchy::Point q = hierarchy_.Sample(s, from.x, from.y);
@@ -217,27 +240,20 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set,
                               (distance * distance * distance);
         if (weight <= 0.0) continue;
         const double light = fromCluster ? weight * Brightness(q, d) : 0.0;
-        ++rays, ++traced;
-        total += weight;
-        totalLight += light;
+        ++rays, ++tally.traced;
+        tally.total += weight;
+        tally.totalLight += light;
         // From a closed instance held from outside, the ray ends where it enters the box:
         // what its own contents do to its light is in the intensity it was given.
         double length = distance * (1.0 - 1e-4);
         if (held && q.closed >= 0)
             length = std::min(length, HeldEntry(q.closed, p.position, d / distance));
         const double through = length > 0.0 ? Passed(p, q.closed, d / distance, length, held) : 1.0;
-        visible += weight * through;
-        visibleLight += light * through;
-        passed += through;
+        tally.visible += weight * through;
+        tally.visibleLight += light * through;
+        tally.passed += through;
     }
-    Sight sight;
-    sight.spread = VisibilitySpread(traced > 0 ? passed / traced : 1.0, visibilityRays_);
-    if (totalLight > 0.0) {
-        sight.visibility = visibleLight / totalLight;
-    } else {
-        sight.visibility = total > 0.0 ? visible / total : 0.0;
-    }
-    return sight;
+    return Seen(tally, 0.0);
 }
 
 double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,

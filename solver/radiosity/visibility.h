@@ -34,6 +34,19 @@ inline double VisibilitySpread(double visible, int rays) {
 // those that value its transfer where the verdict rested on the first (Refiner::Value).
 enum class RaySet : std::uint64_t { kJudging = 0x5EED, kValuing = 0x5EEE };
 
+// What a link's rays showed so far (LinkVisibility::Between), to go on from. They come in
+// two rounds: the even points of the link's lattice, a lattice of half as many, then the
+// odd ones, traced only where the first round leaves the verdict open (Refiner::JudgePair).
+struct LinkRays {
+    // The rays of the first round, of `count`: half, where even and at least 4.
+    static int First(int count) { return count >= 4 && count % 2 == 0 ? count / 2 : count; }
+    int taken = 0;   // rays taken so far, traced or not (their ends turned away)
+    int traced = 0;  // and traced
+    double passed = 0.0;
+    double visible = 0.0, total = 0.0;            // each ray weighted by what it carries
+    double visibleLight = 0.0, totalLight = 0.0;  // and by the light its sender's point sends
+};
+
 // What a link's rays show.
 struct Sight {
     double visibility = 0.0;
@@ -102,6 +115,9 @@ class LinkVisibility {
     // whole scene's organs where the occlusion has them (ShadowView: exact shadows), else
     // what lies outside the problem as well (Occlusion::Transmittance).
     Sight Between(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays) const;
+    // The same from the link's first `upTo` rays, going on from those of `tally`.
+    Sight Between(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays, LinkRays& tally,
+                  int upTo) const;
 
     // The lit fraction of node r's area as seen from directional source `source`: sample
     // points, each with a direction of the source's cone (stratified over it; one folded
@@ -115,7 +131,8 @@ class LinkVisibility {
                       RaySet set, std::int64_t& rays) const;
 
   private:
-    Sight BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays) const;
+    Sight BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
+                         LinkRays& tally, int upTo) const;
     // What passes along a link's ray from p, `length` long, towards an end inside closed
     // instance `closedEnd` (−1: none) or a surface held from outside (`held`): 0 or 1
     // through triangles alone, else the transmittance, the ray's own ends left out.
