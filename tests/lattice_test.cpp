@@ -35,6 +35,28 @@ TEST(RankOneLattice, StratifiesEachCoordinate) {
     }
 }
 
+// A link takes its rays in two rounds, the even points of its lattice then the odd ones
+// (LinkRays): each round on its own takes each of n / 2 strata once in each coordinate,
+// so that the first round is a lattice of half as many points, and the second one too.
+TEST(RankOneLattice, EachHalfStratifiesEachCoordinateByHalves) {
+    for (int count : {4, 8, 16, 32, 64, 100}) {
+        const RankOneLattice& lattice = RankOneLattice::Of(count);
+        const int half = count / 2;
+        for (int round : {0, 1}) {
+            std::vector<int> u(half, 0), v(half, 0);
+            for (int j = 0; j < half; ++j) {
+                const glm::dvec2 p = lattice.Point(2 * j + round, glm::dvec2(0.5 / count));
+                ++u[static_cast<int>(p.x * half)];
+                ++v[static_cast<int>(p.y * half)];
+            }
+            for (int k = 0; k < half; ++k) {
+                EXPECT_EQ(u[k], 1) << count << " round " << round << " stratum " << k;
+                EXPECT_EQ(v[k], 1) << count << " round " << round << " stratum " << k;
+            }
+        }
+    }
+}
+
 // A shifted lattice is uniform: the mean of its estimates of a half-plane's area over
 // shifts is that area, within the Monte Carlo error of the shifts.
 // And it resolves a shadow edge as stratified points cannot: the area of {x cos φ + y
