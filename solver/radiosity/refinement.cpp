@@ -310,12 +310,11 @@ Refiner::Verdict Refiner::JudgePair(std::uint32_t r, std::uint32_t s) const {
 double Refiner::HeldAroundLight(std::uint32_t r, std::uint32_t s,
                                 const std::vector<NodeLink>& links) const {
     const double* intensity = field_.intensity[model_.Slot(s)];
-    const int channels = model_.ChannelSet().Count();
+    const Channels& channels = model_.ChannelSet();
     double power = 0.0;
     for (const NodeLink& link : links) {
-        const double* sent = intensity + link.senderBins.index[0] * channels;
-        double light = 0.0;
-        for (int k = 0; k < channels; ++k) light += sent[k];
+        const double light =
+            channels.Measure(intensity + link.senderBins.index[0] * channels.Count());
         power += static_cast<double>(link.transfer[0]) * light *
                  model_.ProjectedArea(r, glm::dvec3(link.toSender));
     }

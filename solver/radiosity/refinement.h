@@ -92,13 +92,12 @@ class Refiner {
     }
     double SourceThreshold(std::uint32_t r) const;
     // The W that links from held instance s bring organs r among its leaves
-    // (HeldAroundLinks), all channels: such a link hands every part of r the light the
-    // held instance sends where r's points are, which varies across r as the depth of
-    // its organs behind each point does, so r is split while that light exceeds the
-    // threshold. Split down to half the held instance's radius only, the 119k-leaf tree's
-    // NIR L2 error was 2.04 % at ε = 1e-4 and the 10,000-leaf tree's 1.80 %; split
-    // further so, 1.94 and 1.54 % (docs/results.md), each for 3 % more time (interleaved
-    // runs); the daemon's 1,000-leaf tree at ε = 3e-3 is solved as it was.
+    // (HeldAroundLinks), as refinement measures channels: such a link hands every part of r the
+    // light the held instance sends where r's points are, which varies across r as the depth of its
+    // organs behind each point does, so r is split while that light exceeds the threshold. Split
+    // down to half the held instance's radius only, the 119k-leaf tree's NIR L2 error was 2.04 % at
+    // ε = 1e-4 and the 10,000-leaf tree's 1.80 %; split further so, 1.94 and 1.54 %, each for 3 %
+    // more time (interleaved runs); the daemon's 1,000-leaf tree at ε = 3e-3 is solved as it was.
     double HeldAroundLight(std::uint32_t r, std::uint32_t s,
                            const std::vector<NodeLink>& links) const;
     // Organs among a held instance's leaves: split down to this share of its radius always,
