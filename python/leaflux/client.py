@@ -10,6 +10,7 @@ once more.
 from __future__ import annotations
 
 import logging
+import math
 import os
 import time
 from dataclasses import dataclass
@@ -164,8 +165,10 @@ class Client:
         self._socket.send_multipart([b"", payload])
         deadline = time.monotonic() + timeout_s
         while True:
-            left_ms = max(0, int(1000 * (deadline - time.monotonic())))
-            if not self._socket.poll(left_ms):
+            left_s = deadline - time.monotonic()
+            if left_s <= 0 or not self._socket.poll(math.ceil(1000 * left_s)):
+                if time.monotonic() < deadline:
+                    continue  # woke early: the timeout never comes before the one asked for
                 self.reconnect()  # a late reply must not answer the next request
                 raise RequestTimeout(self.endpoint, kind, timeout_s)
             reply = pb.Reply()

@@ -289,14 +289,17 @@ public final class LeafluxClient implements AutoCloseable {
 
     /** The last frame of the next message, or null when none comes before {@code deadline}. */
     private byte[] receiveLastFrame(long deadline) {
-        long leftMs = (deadline - System.nanoTime()) / 1_000_000L;
-        if (leftMs <= 0) {
-            return null;
-        }
-        socket.setReceiveTimeOut((int) Math.min(Integer.MAX_VALUE, leftMs));
-        byte[] frame = socket.recv(0);
-        if (frame == null) {
-            return null;
+        byte[] frame = null;
+        // The socket's own clock may wake a millisecond early: wait again until the deadline
+        // has truly passed, so that a timeout never comes before the one asked for.
+        while (frame == null) {
+            long leftNs = deadline - System.nanoTime();
+            if (leftNs <= 0) {
+                return null;
+            }
+            long leftMs = (leftNs + 999_999L) / 1_000_000L;
+            socket.setReceiveTimeOut((int) Math.min(Integer.MAX_VALUE, leftMs));
+            frame = socket.recv(0);
         }
         // The frames of one message come together: read them through to the payload.
         while (socket.hasReceiveMore()) {
