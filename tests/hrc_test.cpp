@@ -490,8 +490,9 @@ void AddStackedPlant(Scene& scene, const std::string& topOptics, const std::stri
 // it (HrcOptions::exposureRays). Two black leaves of one plant, one above the other, under
 // a small lamp 5 m up that lights the plant through one link: handed down evenly, each
 // leaf gets half of the light; by exposure, the top leaf nearly all of it, as the Monte
-// Carlo reference finds, and the two absorb the same power either way. The lamp reflects a
-// little: a black one's links into a cluster of organs split the cluster first.
+// Carlo reference finds, and the two absorb the same power either way (to the single
+// precision the shares are kept in, 2^-24 of each). The lamp reflects a little: a black
+// one's links into a cluster of organs split the cluster first.
 TEST(HrcExposure, SharesOutTheLightAClusterGathersTowardsTheOpenLeaf) {
     Scene scene = OneBandScene({{"leaf", Leaf(0, 0)}, {"lamp", Opaque(0.01)}});
     AddStackedPlant(scene, "leaf", "leaf");
@@ -506,7 +507,7 @@ TEST(HrcExposure, SharesOutTheLightAClusterGathersTowardsTheOpenLeaf) {
     settings.monteCarlo.samplesPerReceiver = 4096;
     const Solution reference = Solve(prepared, settings);
     EXPECT_NEAR(open.balance[0].absorbedW, even.balance[0].absorbedW,
-                1e-9 * even.balance[0].absorbedW);
+                1e-7 * even.balance[0].absorbedW);
     const BandLight& evenTop = even.light[0][0];
     const BandLight& evenBottom = even.light[1][0];
     EXPECT_NEAR(evenBottom.irradianceUpperWm2, evenTop.irradianceUpperWm2,

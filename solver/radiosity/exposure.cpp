@@ -27,6 +27,7 @@ Exposure::Exposure(const NodeModel& model, const RayScene& scene, int raysPerDir
     std::vector<DirectionSet::Interpolation> toCoarse;
     for (int d = 0; d < bins_; ++d) toCoarse.push_back(coarse.Locate(directions.Direction(d)));
     std::atomic<std::int64_t> traced{0};
+    const int half = (raysPerDirection + 1) / 2;
     tbb::parallel_for(std::size_t{0}, clusters.size(), [&](std::size_t i) {
         SetFlushToZero();
         const std::uint32_t n = clusters[i];
@@ -41,18 +42,28 @@ Exposure::Exposure(const NodeModel& model, const RayScene& scene, int raysPerDir
                 const glm::dvec3& omega = coarse.Direction(d);
                 Random random(StreamSeed(0xE7905, c, d));
                 double seen = 0.0, total = 0.0;
-                for (int k = 0; k < raysPerDirection; ++k) {
+                int open = 0, shut = 0, traced = 0;
+                for (int i = 0; i < raysPerDirection; ++i) {
+                    // The even strata first, then the odd: where the first half all agree,
+                    // the child is taken as wholly open (or shut) that way.
+                    const int k = i < half ? 2 * i : 2 * (i - half) + 1;
+                    if (i == half && (open == 0) != (shut == 0)) break;
                     const Hierarchy::Point p = hierarchy.Sample(
                         c, (k + random.Uniform()) / raysPerDirection, random.Uniform());
+                    ++traced;
                     const double weight = model.ReceivingWeight(p.triangle, p.normal, omega);
                     if (weight <= 0.0) continue;
                     total += weight;
                     if (!scene.OccludedByGroup({p.position, p.triangle}, omega, 2.0 * C.radius,
-                                               group))
+                                               group)) {
                         seen += weight;
+                        ++open;
+                    } else {
+                        ++shut;
+                    }
                 }
                 coarseOpen[d] = total > 0.0 ? seen / total : 1.0;
-                local += raysPerDirection;
+                local += traced;
             }
             for (int d = 0; d < bins_; ++d) {
                 const DirectionSet::Interpolation& w = toCoarse[d];

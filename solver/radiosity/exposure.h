@@ -4,11 +4,14 @@
 // much as the exposed ones. Each child c of a cluster C (not flat) takes instead its share
 // weighted by e_c(ω), the fraction of its area facing ω that C's own triangles leave open
 // towards ω, over the mean of e over C's children: the light C gathers is all handed down.
-// e is found by rays from c's points towards each direction of the 10-direction set and
-// interpolated to the cluster light's set (with 34 directions of their own, the 10k tree
-// took 30 % longer for an error 2.02 → 1.97 % instead of 2.01 %). On the 500-leaf NIR
-// canopy at ε = 1e-4 the NIR L2 error went from 0.985 to 0.911 %, on the dense canopy from
-// 2.21 to 2.02 %. Owns its table; reads the hierarchy and the node model.
+// e is found by rays from c's points towards each direction of the 10-direction set, half
+// of them first: where those all agree, c is taken as wholly open (or shut) that way. On
+// the 119k tree that left out 17 % of the solve's rays (18.6 → 15.4 M) for a NIR L2 error
+// of 1.960 % instead of 1.951. e is interpolated to the cluster light's set (with 34
+// directions of their own, the 10k tree took 30 % longer for an error 2.02 → 1.97 %
+// instead of 2.01 %). On the 500-leaf NIR canopy at ε = 1e-4 the NIR L2 error went from
+// 0.985 to 0.911 %, on the dense canopy from 2.21 to 2.02 %. Owns its table; reads the
+// hierarchy and the node model.
 #pragma once
 
 #include <cstdint>
