@@ -93,6 +93,40 @@ TEST(DirectionSet, EveryDirectionLiesInAFaceWithValidWeights) {
     }
 }
 
+// Locate's face holds the direction: its unclamped barycentric weights (gnomonic) are all
+// ≥ 0 and put the point back on d (the clamped weights Locate returns would pass
+// EveryDirectionLiesInAFaceWithValidWeights from a neighbouring face too). At every level,
+// for random directions and for those on the subdivision's edges, where rounding decides
+// (the edges' midpoints), and at the faces' centres.
+TEST(DirectionSet, LocateFindsTheFaceHoldingTheDirection) {
+    Random random(11);
+    std::vector<glm::dvec3> randomDirections;
+    for (int i = 0; i < 20000; ++i)
+        randomDirections.push_back(UniformSphere(random.Uniform(), random.Uniform()));
+    for (int level = 0; level <= 4; ++level) {
+        const DirectionSet& set = DirectionSet::OfLevel(level);
+        std::vector<glm::dvec3> all = randomDirections;
+        for (const auto& [a, b, c] : set.Faces()) {
+            all.push_back(glm::normalize(set.Direction(a) + set.Direction(b)));
+            all.push_back(glm::normalize(set.Direction(a) + set.Direction(b) + set.Direction(c)));
+        }
+        for (const glm::dvec3& d : all) {
+            const auto located = set.Locate(d);
+            const glm::dvec3 &a = set.Direction(located.vertex[0]),
+                             &b = set.Direction(located.vertex[1]),
+                             &c = set.Direction(located.vertex[2]);
+            const glm::dvec3 w(glm::dot(glm::cross(b, c), d), glm::dot(glm::cross(c, a), d),
+                               glm::dot(glm::cross(a, b), d));
+            const double sum = w.x + w.y + w.z;
+            ASSERT_GT(sum, 0.0);
+            EXPECT_GE(glm::min(w.x, glm::min(w.y, w.z)), -1e-12 * sum)
+                << "level " << level << " d " << d.x << ' ' << d.y << ' ' << d.z;
+            const glm::dvec3 back = glm::normalize(w.x * a + w.y * b + w.z * c);
+            EXPECT_NEAR(glm::distance(back, d), 0.0, 1e-12) << "level " << level;
+        }
+    }
+}
+
 // Angle is std::atan2 for a sine ≥ 0, to a few ulp: over every octant of the half-plane,
 // at the bounds between its remainders' centres, near the axes and at extreme magnitudes.
 TEST(Angle, IsTheArctangentOfTheHalfPlane) {
