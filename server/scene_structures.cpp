@@ -204,7 +204,7 @@ void ExpandPlacements(const v1::Scene& message, const MeshLibrary& meshes,
             }
             if (node.parent == kNoParent) {
                 node.parent = job.rootParent;
-                if (node.parentFromLocal == Frame(1.0)) {
+                if (node.parentFromLocal == Frame()) {
                     node.parentFromLocal = job.rootFrame;  // exact: no product with identity
                 } else {
                     node.parentFromLocal = job.rootFrame * glm::dmat4(node.parentFromLocal);
@@ -389,14 +389,14 @@ class InstancedWriter {
         for (const auto& [name, value] : node.attributes)
             key.attributes.push_back({name, Bits(value)});
         key.mesh = node.organ ? node.organ->mesh.get() : nullptr;
-        key.optics = node.organ ? node.organ->opticsId : std::string();
+        key.optics = node.organ ? node.organ->opticsId.str() : std::string();
         bool shareable = true;
         key.name = NameTemplate(node, shareable);
         if (!shareable) key.name += "\n" + std::to_string(node.id);  // a class of its own
         for (std::size_t c : children_[i]) {
             ChildKey child{static_cast<std::int64_t>(nodes_[c].id - node.id), {}, class_[c]};
             for (int k = 0; k < 12; ++k)
-                child.frame[k] = Bits(nodes_[c].parentFromLocal[k / 3][k % 3]);
+                child.frame[k] = Bits(nodes_[c].parentFromLocal.At(k / 3, k % 3));
             key.children.push_back(child);
         }
         const auto [it, added] = classes.emplace(std::move(key), static_cast<int>(info_.size()));

@@ -51,5 +51,25 @@ TEST(Attributes, InsertsPairsInAnyOrderKeepingTheValuesItHas) {
     EXPECT_NE(attributes, same);
 }
 
+// Held by pointer, a node's attributes are still a value: a copy is its own, and none at
+// all equal an emptied set.
+TEST(Attributes, CopiesAreValues) {
+    Attributes original;
+    original["height"] = 2.0;
+    Attributes copy = original;
+    copy["height"] = 3.0;
+    copy["width"] = 1.0;
+    EXPECT_EQ(original.at("height"), 2.0);
+    EXPECT_EQ(original.size(), 1u);
+    copy = original;
+    EXPECT_EQ(copy, original);
+    Attributes none, emptied;
+    emptied.insert(original.begin(), original.begin());
+    EXPECT_EQ(none, emptied);
+    EXPECT_TRUE(none.empty());
+    EXPECT_EQ(none.find("height"), none.end());
+    EXPECT_EQ(none.count("height"), 0u);
+}
+
 }  // namespace
 }  // namespace leaflux

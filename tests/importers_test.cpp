@@ -74,8 +74,8 @@ TEST(ReadCan, DecodesLabelsOfTheSeedlingTray) {
         plants += node.type == NodeType::kPlant;
         if (!node.organ) continue;
         EXPECT_NE(node.parent, kNoParent);
-        species1 += node.organ->opticsId.rfind("species1", 0) == 0;
-        species2 += node.organ->opticsId.rfind("species2", 0) == 0;
+        species1 += node.organ->opticsId.str().rfind("species1", 0) == 0;
+        species2 += node.organ->opticsId.str().rfind("species2", 0) == 0;
     }
     EXPECT_GT(plants, 1);
     EXPECT_GT(species1, 0);

@@ -66,8 +66,8 @@ TEST(SceneFile, RoundTripsAGeneratedTreeKeepingSharedMeshes) {
         EXPECT_EQ(back.nodes[i].type, scene.nodes[i].type);
         for (int c = 0; c < 4; ++c) {
             for (int r = 0; r < 3; ++r) {
-                EXPECT_DOUBLE_EQ(back.nodes[i].parentFromLocal[c][r],
-                                 scene.nodes[i].parentFromLocal[c][r]);
+                EXPECT_DOUBLE_EQ(back.nodes[i].parentFromLocal.At(c, r),
+                                 scene.nodes[i].parentFromLocal.At(c, r));
             }
         }
         if (back.nodes[i].organ) meshes.insert(back.nodes[i].organ->mesh.get());

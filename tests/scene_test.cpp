@@ -113,9 +113,15 @@ std::vector<BadInput> BadInputs() {
          {}},
         {"cycle", [](Scene& s) { s.nodes[0].parent = 2; }, ErrorCode::kCycle, "parent", {}},
         {"self parent", [](Scene& s) { s.nodes[0].parent = 1; }, ErrorCode::kCycle, "parent", 1},
-        {"NaN frame", [](Scene& s) { s.nodes[0].parentFromLocal[3][0] = kNan; },
+        {"NaN frame",
+         [](Scene& s) {
+             s.nodes[0].parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(kNan, 0, 0));
+         },
          ErrorCode::kInvalidArgument, "frame", 1},
-        {"singular frame", [](Scene& s) { s.nodes[0].parentFromLocal[2] = glm::dvec3(0.0); },
+        {"singular frame",
+         [](Scene& s) {
+             s.nodes[0].parentFromLocal = glm::scale(glm::dmat4(1.0), {1, 1, 0});
+         },
          ErrorCode::kDegenerate, "frame", 1},
         {"infinite age", [](Scene& s) { s.nodes[0].age = kInf; }, ErrorCode::kInvalidArgument,
          "age", 1},
@@ -145,8 +151,9 @@ std::vector<BadInput> BadInputs() {
          ErrorCode::kDegenerate, "organ.mesh.triangles", 2},
         {"frame collapses a leaf",
          [](Scene& s) {
-             s.nodes[0].parentFromLocal = glm::dmat4(1.0);
-             s.nodes[0].parentFromLocal[1] = glm::dvec3(1e-40, 0, 0);
+             glm::dmat4 frame(1.0);
+             frame[1] = glm::dvec4(1e-40, 0, 0, 0);
+             s.nodes[0].parentFromLocal = frame;
          },
          ErrorCode::kDegenerate, "frame", 1},
         {"duplicate organ name",
@@ -186,11 +193,13 @@ std::vector<BadInput> BadInputs() {
              s.nodes[1].parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e20));
          },
          ErrorCode::kInvalidArgument, "organ.mesh.triangles[0]", 2},
+        // Past single precision's range (3.4e38), where a frame keeps its scale, the frame
+        // itself is refused as not finite.
         {"leaf scaled by 1e300",
          [](Scene& s) {
              s.nodes[1].parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e300));
          },
-         ErrorCode::kInvalidArgument, "organ.mesh.triangles[0]", 2},
+         ErrorCode::kInvalidArgument, "frame", 2},
         {"sun of 1e308 W/m²",
          [](Scene& s) { s.sources.suns[0].normalIrradianceWm2 = {1e308}; },
          ErrorCode::kInvalidArgument,
@@ -272,12 +281,32 @@ TEST_P(RejectsBadInput, WithTypedErrorNamingTheField) {
 INSTANTIATE_TEST_SUITE_P(Scene, RejectsBadInput,
                          ::testing::Range(0, static_cast<int>(BadInputs().size())));
 
+// A frame keeps its translation in double and its rotation and scale in single precision:
+// a plant 100 km out keeps its place to the nanometre, its orientation within 1e-7.
+TEST(Frame, KeepsTheTranslationExactAndTheRotationInSinglePrecision) {
+    glm::dmat4 m = glm::rotate(glm::dmat4(1.0), 0.3, glm::normalize(glm::dvec3(1, 2, 3)));
+    m[3] = glm::dvec4(1e5 + 1e-9, -2e5, 3.25e-7, 1.0);
+    const Frame frame = m;
+    const glm::dmat4 back = frame;
+    EXPECT_EQ(back[3], m[3]);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(back[c][3], 0.0);
+        for (int r = 0; r < 3; ++r) {
+            EXPECT_NEAR(back[c][r], m[c][r], 1e-7) << c << ' ' << r;
+            EXPECT_EQ(frame.At(c, r), back[c][r]);
+        }
+    }
+    EXPECT_EQ(Frame(), Frame(glm::dmat4(1.0)));
+    EXPECT_EQ(glm::dmat4(Frame()), glm::dmat4(1.0));
+}
+
 TEST(Scene, WorldFromLocalComposesParentsFirst) {
     Scene scene = ValidScene();
-    scene.nodes[0].parentFromLocal = glm::dmat4(1.0);
-    scene.nodes[0].parentFromLocal[3] = glm::dvec3(10, 0, 0);  // plant at x = 10
-    scene.nodes[1].parentFromLocal = glm::dmat4(2.0);          // leaf scaled ×2
-    scene.nodes[1].parentFromLocal[3] = glm::dvec3(0, 1, 0);
+    scene.nodes[0].parentFromLocal =
+        glm::translate(glm::dmat4(1.0), glm::dvec3(10, 0, 0));  // plant at x = 10
+    glm::dmat4 leaf(2.0);                                       // leaf scaled ×2
+    leaf[3] = glm::dvec4(0, 1, 0, 1);
+    scene.nodes[1].parentFromLocal = leaf;
     const auto world = WorldFromLocal(scene);
     const glm::dvec3 p = glm::dvec3(world.at(2) * glm::dvec4(1, 0, 0, 1));
     EXPECT_EQ(p, glm::dvec3(12, 1, 0));
@@ -285,7 +314,7 @@ TEST(Scene, WorldFromLocalComposesParentsFirst) {
 
 TEST(Flatten, KeepsMillimetresFarFromTheOrigin) {
     Scene scene = ValidScene();
-    scene.nodes[0].parentFromLocal[3] = glm::dvec3(1e5, 1e5, 0);
+    scene.nodes[0].parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(1e5, 1e5, 0));
     scene.environment.clear();
     scene.nodes[1].organ->mesh = Rectangle(0.001, 0.001, 1.0);
     const FlatScene flat = Flatten(scene);

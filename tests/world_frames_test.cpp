@@ -29,7 +29,7 @@ glm::dmat4 ByWalkingUp(const Scene& scene, NodeId id) {
     while (id != kNoParent) {
         const Node& node = *std::find_if(scene.nodes.begin(), scene.nodes.end(),
                                          [&](const Node& n) { return n.id == id; });
-        frame = node.parentFromLocal * frame;
+        frame = glm::dmat4(node.parentFromLocal) * frame;
         id = node.parent;
     }
     return frame;

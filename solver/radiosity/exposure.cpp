@@ -42,28 +42,28 @@ Exposure::Exposure(const NodeModel& model, const RayScene& scene, int raysPerDir
                 const glm::dvec3& omega = coarse.Direction(d);
                 Random random(StreamSeed(0xE7905, c, d));
                 double seen = 0.0, total = 0.0;
-                int open = 0, shut = 0, traced = 0;
-                for (int i = 0; i < raysPerDirection; ++i) {
+                int passed = 0, blocked = 0, cast = 0;
+                for (int ray = 0; ray < raysPerDirection; ++ray) {
                     // The even strata first, then the odd: where the first half all agree,
                     // the child is taken as wholly open (or shut) that way.
-                    const int k = i < half ? 2 * i : 2 * (i - half) + 1;
-                    if (i == half && (open == 0) != (shut == 0)) break;
+                    const int k = ray < half ? 2 * ray : 2 * (ray - half) + 1;
+                    if (ray == half && (passed == 0) != (blocked == 0)) break;
                     const Hierarchy::Point p = hierarchy.Sample(
                         c, (k + random.Uniform()) / raysPerDirection, random.Uniform());
-                    ++traced;
+                    ++cast;
                     const double weight = model.ReceivingWeight(p.triangle, p.normal, omega);
                     if (weight <= 0.0) continue;
                     total += weight;
                     if (!scene.OccludedByGroup({p.position, p.triangle}, omega, 2.0 * C.radius,
                                                group)) {
                         seen += weight;
-                        ++open;
+                        ++passed;
                     } else {
-                        ++shut;
+                        ++blocked;
                     }
                 }
                 coarseOpen[d] = total > 0.0 ? seen / total : 1.0;
-                local += traced;
+                local += cast;
             }
             for (int d = 0; d < bins_; ++d) {
                 const DirectionSet::Interpolation& w = toCoarse[d];

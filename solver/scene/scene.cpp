@@ -220,7 +220,7 @@ void ValidateNode(const Scene& scene, const Node& node) {
     if (!InvertibleFrame(node.parentFromLocal)) {
         for (int c = 0; c < 4; ++c) {
             for (int r = 0; r < 3; ++r) {
-                if (!std::isfinite(node.parentFromLocal[c][r]))
+                if (!std::isfinite(node.parentFromLocal.At(c, r)))
                     throw InputError(ErrorCode::kInvalidArgument, "frame", "is not finite",
                                      node.id);
             }
