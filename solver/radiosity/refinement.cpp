@@ -267,7 +267,7 @@ Refiner::Verdict Refiner::JudgePair(std::uint32_t r, std::uint32_t s) const {
         visibility_.Between(r, s, RaySet::kJudging, verdict.rays, tally,
                             model_.FirstHand(s) ? visibility_.VisibilityRays()
                                                 : LinkRays::First(visibility_.VisibilityRays()));
-    if (e.Error(sight.spread) > threshold) {
+    if (tally.taken < visibility_.VisibilityRays() && e.Error(sight.spread) > threshold) {
         sight = visibility_.Between(r, s, RaySet::kJudging, verdict.rays, tally,
                                     visibility_.VisibilityRays());
     }

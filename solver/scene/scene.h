@@ -94,7 +94,7 @@ struct Organ {
 // the scene refuses the frame as not finite.
 class Frame {
   public:
-    Frame() = default;  // the identity
+    Frame() = default;                                 // the identity
     Frame(const glm::dmat4& m) : translation_(m[3]) {  // NOLINT(google-explicit-constructor)
         for (int c = 0; c < 3; ++c) {
             for (int r = 0; r < 3; ++r) linear_[c][r] = static_cast<float>(m[c][r]);
