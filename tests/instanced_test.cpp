@@ -29,10 +29,9 @@ namespace {
 
 using testing::Copies, testing::Hrc, testing::Plants, testing::PlantsInstanced;
 
-// A plant solved whole takes the light that arrived on its box as falling evenly over it,
-// where its neighbours shade part of it: measured within 4.7 % (PAR) and 4.8 % (NIR) of
-// what its leaves absorb in the flattened scene (APlantSolvedWholeAbsorbsWhatItsLeavesDo),
-// much of it the noise of the 32 rays of each source's link to its box.
+// A plant solved whole takes the light that arrived on its box as its phase function does
+// light falling evenly over it: measured within 3.2 % (PAR) and 1.5 % (NIR) of what its
+// leaves absorb in the flattened scene (APlantSolvedWholeAbsorbsWhatItsLeavesDo).
 constexpr double kWholeTolerance[2] = {0.05, 0.05};
 
 // A policy that finds no structure: one level, the whole scene, as HRC solves it.
@@ -238,6 +237,38 @@ TEST(Instanced, APlantSolvedWholeAbsorbsWhatItsLeavesDo) {
         EXPECT_NE(line.find(",,,"), std::string::npos) << line;
     }
     EXPECT_EQ(plants, 4 * 2);  // four plants, two bands
+}
+
+// Plants whose crowns grow into one another, solved whole: the middle one of three stands
+// in both neighbours' leaves, which shade it inside its own box. Their organs black, so
+// that a plant absorbs what reaches it straight, each plant absorbs what its leaves do in
+// the flattened scene: measured 0.2, 2.9 and 0.1 % less (PAR; the test prints each), as
+// far apart (30 m) 0.8, 3.0 and 0.8 % less, the error of the phase function itself. From
+// where rays from points of its box left the box, the neighbours' leaves inside it never
+// shaded a plant: 6 to 13 % more. Bound: 4 %, the phase function's 3 % and the noise of
+// the shade's estimate (LinkVisibility::FromSource).
+TEST(Instanced, PlantsSolvedWholeInEachOthersCrownsTakeTheirShade) {
+    Scene scene = Copies(3, 300, 0.3);
+    for (Optics& optics : scene.optics) {
+        for (BandOptics& band : optics.bands) band = {};
+    }
+    const PreparedScene prepared(scene);
+    const Solution hrc = Hrc(prepared, 1e-4);
+    const InstancedSolution instanced = PlantsSolvedWhole(scene, prepared, false);
+    ASSERT_EQ(instanced.solution.wholeStructures.size(), 3u);
+    std::unordered_map<NodeId, StructureLight> flattened;
+    for (StructureLight& s : AggregateStructures(scene, prepared.Flat(), hrc))
+        flattened.emplace(s.node, std::move(s));
+    for (const StructureLight& whole : instanced.solution.wholeStructures) {
+        const StructureLight& leaves = flattened.at(whole.node);
+        for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+            const double off = whole.bands[b].absorbedW / leaves.bands[b].absorbedW - 1.0;
+            std::printf("%s band %zu: solved whole %.2f W, its leaves %.2f W (%+.1f %%)\n",
+                        whole.name.c_str(), b, whole.bands[b].absorbedW, leaves.bands[b].absorbedW,
+                        100.0 * off);
+            EXPECT_LT(std::abs(off), 0.04) << whole.name << " band " << b;
+        }
+    }
 }
 
 // Handed down from the plants solved whole (InstancedOptions::pushDown), every leaf has

@@ -86,6 +86,30 @@ TEST(RayScene, AnOcclusionQueryPassesTheTrianglesItSkips) {
         EXPECT_EQ(RayScene::InRanges(apart, t), t < 2 || (t >= 4 && t < 6)) << t;
 }
 
+TEST(RayScene, OccludedAmongMeetsOnlyTheTrianglesListed) {
+    // Three plates stacked 1 m apart, two triangles each: a ray up from below meets the
+    // listed ones alone, within its length; the corners are the plates'.
+    const FlatScene flat = Plates({Rectangle(1, 1, 0), Rectangle(1, 1, 1), Rectangle(1, 1, 2)});
+    const RayScene rays(flat, std::nullopt);
+    const RayStart below{flat.ToLocal({0.1, 0.2, -1})};
+    const glm::dvec3 up{0, 0, 1};
+    const RayScene::TriangleRanges top{{4, 6}}, none{{6, 6}};
+    EXPECT_TRUE(rays.OccludedAmong(below, up, 10.0, top));
+    EXPECT_FALSE(rays.OccludedAmong(below, up, 2.5, top));  // ends short of the top plate
+    EXPECT_FALSE(rays.OccludedAmong(below, up, 10.0, none));
+    // From a triangle of the listed ones, that one is left out.
+    const RayStart onTop{flat.ToLocal({0.1, 0.2, 2}), 4};
+    EXPECT_FALSE(rays.OccludedAmong(onTop, up, 10.0, top));
+    for (std::uint32_t t = 0; t < flat.triangles.size(); ++t) {
+        const std::array<glm::dvec3, 3> corners = rays.Corners(t);
+        const Triangle& tri = flat.triangles[t];
+        for (int k = 0; k < 3; ++k) {
+            const glm::dvec3& expected = k == 0 ? tri.a : k == 1 ? tri.b : tri.c;
+            EXPECT_NEAR(glm::length(corners[k] - expected), 0.0, 1e-6) << t << ' ' << k;
+        }
+    }
+}
+
 TEST(RayScene, TracesRaysOfOneDirectionTogetherAsOneByOne) {
     // Plates 1 µm to 0.3 m apart, shifted sideways: rays leave every triangle (and points
     // off the surfaces) towards one sun, some blocked, some not.

@@ -13,6 +13,11 @@ namespace {
 // uniform over it rather than to points uniform on it.
 constexpr double kNear = 0.5;
 
+// Rays' weights: all of them, and those that passed.
+struct Tally {
+    double total = 0.0, visible = 0.0;
+};
+
 // The closed instances a ray leaves out: those of its two ends (−1: none).
 struct Exclusion {
     std::uint32_t ids[2];
@@ -256,9 +261,58 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std:
     return Seen(tally, 0.0);
 }
 
+LinkVisibility::OrganLight LinkVisibility::ClosedOrganLight(std::int32_t c, const glm::dvec3& x,
+                                                            const glm::dvec3& toward) const {
+    const ShadowView& shadows = occlusion_.Shadows();
+    const ClosedNode& node = hierarchy_.Closed()[c];
+    if (!node.shadowTriangles) return {};
+    const RayScene::TriangleRanges& own = *node.shadowTriangles;
+    // x's place in its box, each coordinate uniform in [0, 1) (Hierarchy::SampleClosed).
+    const glm::dvec3 size = node.boxMax - node.boxMin;
+    const glm::dvec3 local = occlusion_.InInstance(c, x);
+    glm::dvec3 f(0.5);
+    for (int i = 0; i < 3; ++i) {
+        if (size[i] > 0.0) f[i] = std::clamp((local[i] - node.boxMin[i]) / size[i], 0.0, 1.0);
+    }
+    // A triangle by the first (the lattice's, stratified over the organs in their order),
+    // a point of it by the other two.
+    std::uint64_t count = 0;
+    for (const auto& range : own) count += range[1] - range[0];
+    if (count == 0) return {};
+    std::uint64_t k = std::min(count - 1, static_cast<std::uint64_t>(f.x * count));
+    std::uint32_t t = own.front()[0];
+    for (const auto& range : own) {
+        if (k < range[1] - range[0]) {
+            t = range[0] + static_cast<std::uint32_t>(k);
+            break;
+        }
+        k -= range[1] - range[0];
+    }
+    const std::array<glm::dvec3, 3> corners = shadows.rays->Corners(t);
+    OrganLight organ;
+    organ.weight = 0.5 * std::abs(glm::dot(
+                             glm::cross(corners[1] - corners[0], corners[2] - corners[0]), toward));
+    if (!(organ.weight > 0.0)) return organ;
+    const glm::dvec3 w = UniformTriangle(f.y, f.z);
+    const RayStart start{w.x * corners[0] + w.y * corners[1] + w.z * corners[2], t};
+    // The first triangle it meets: none, it is lit; one of its own organs, it is not, nor
+    // past them; another, it is not, and past its own organs only if none lies further on
+    // (in its box: past its side, the ray has passed them).
+    const RayHit hit = shadows.rays->Trace(start, toward);
+    organ.lit = hit.fate != RayFate::kHit;
+    organ.ownLit =
+        organ.lit ||
+        (!RayScene::InRanges(own, hit.triangle) &&
+         !shadows.rays->OccludedAmong(
+             hit.next, toward,
+             std::max(0.0, occlusion_.ChordOf(c, hit.next.origin - shadows.offset, toward).exit),
+             own));
+    return organ;
+}
+
 double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
-                                  const DirectionalSource& light, RaySet set,
-                                  std::int64_t& rays) const {
+                                  const DirectionalSource& light, RaySet set, std::int64_t& rays,
+                                  int rounds) const {
     Random random(StreamSeed(set == RaySet::kJudging ? 0x50C : 0x50D, r, source));
     const SourceSampling& sampling = sourceSampling_[source];
     const int count = sampling.lattice->Count();
@@ -269,50 +323,87 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
     thread_local std::vector<std::uint8_t> occluded;
     thread_local std::vector<std::int32_t> closed;
     starts.clear(), directions.clear(), weights.clear(), closed.clear();
-    const glm::dvec2 shift(random.Uniform(), random.Uniform());
-    // The cells of the cone in a random order: in a fixed one, each point of the lattice
-    // would always take its direction from the same cell, a bias where a point lies
-    // and where the light comes from go together (the box of a closed instance).
     thread_local std::vector<int> cells;
-    if (!beam) RandomStrata(random, cells, count);
-    for (int i = 0; i < count; ++i) {
-        const glm::dvec2 at = sampling.lattice->Point(i, shift);
-        const Hierarchy::Point p = hierarchy_.Sample(r, at.x, at.y);
-        glm::dvec3 toward = light.toward;
-        if (!beam) {
-            const int cell = cells[i];
-            toward = light.Direction((cell % sampling.rings + random.Uniform()) / sampling.rings,
-                                     (cell / sampling.rings + random.Uniform()) / sampling.turns);
+    for (int round = 0; round < rounds; ++round) {
+        const glm::dvec2 shift(random.Uniform(), random.Uniform());
+        // The cells of the cone in a random order: in a fixed one, each point of the
+        // lattice would always take its direction from the same cell, a bias where a point
+        // lies and where the light comes from go together (the box of a closed instance).
+        if (!beam) RandomStrata(random, cells, count);
+        for (int i = 0; i < count; ++i) {
+            const glm::dvec2 at = sampling.lattice->Point(i, shift);
+            const Hierarchy::Point p = hierarchy_.Sample(r, at.x, at.y);
+            glm::dvec3 toward = light.toward;
+            if (!beam) {
+                const int cell = cells[i];
+                toward =
+                    light.Direction((cell % sampling.rings + random.Uniform()) / sampling.rings,
+                                    (cell / sampling.rings + random.Uniform()) / sampling.turns);
+            }
+            const double weight = model_.ReceivingWeight(p.triangle, p.normal, toward);
+            if (weight <= 0.0) continue;
+            starts.push_back({p.position, p.triangle});
+            directions.push_back(toward);
+            weights.push_back(weight);
+            closed.push_back(p.closed);
         }
-        const double weight = model_.ReceivingWeight(p.triangle, p.normal, toward);
-        if (weight <= 0.0) continue;
-        starts.push_back({p.position, p.triangle});
-        directions.push_back(toward);
-        weights.push_back(weight);
-        closed.push_back(p.closed);
     }
     rays += static_cast<std::int64_t>(starts.size());
     double visible = 0.0, total = 0.0;
     if (const ShadowView& shadows = occlusion_.Shadows(); light.beyond && shadows.rays) {
-        // Through the whole scene's triangles, traced together: from a triangle's points, and
-        // from a closed instance's where they leave its box (what its own contents take of
-        // the light is in its phase function).
+        // Through the whole scene's triangles: from a triangle's points, traced together; for a
+        // closed instance, from points of its organs (ClosedOrganLight).
+        double closedWeight = 0.0;
+        Tally organs, boxes;
+        struct ClosedRay {
+            glm::dvec3 origin, direction;
+            std::int32_t closed;
+        };
+        thread_local std::vector<ClosedRay> closedRays;
+        closedRays.clear();
+        std::size_t batch = 0;  // the rays traced together, moved to the front
         for (std::size_t i = 0; i < starts.size(); ++i) {
             total += weights[i];
+            const glm::dvec3 from = starts[i].origin + shadows.offset;
             if (closed[i] >= 0) {
-                const double exit =
-                    occlusion_.ChordOf(closed[i], starts[i].origin, directions[i]).exit;
-                starts[i] = {starts[i].origin + std::max(exit, 0.0) * directions[i] +
-                             shadows.offset};
-            } else {
-                starts[i] = {starts[i].origin + shadows.offset,
-                             shadows.triangleOf[starts[i].triangle]};
+                closedWeight += weights[i];
+                const OrganLight organ =
+                    ClosedOrganLight(closed[i], starts[i].origin, directions[i]);
+                if (organ.ownLit) {
+                    organs.total += weights[i] * organ.weight;
+                    if (organ.lit) organs.visible += weights[i] * organ.weight;
+                }
+                closedRays.push_back({starts[i].origin, directions[i], closed[i]});
+                continue;
             }
+            starts[batch] = {from, shadows.triangleOf[starts[i].triangle]};
+            directions[batch] = directions[i];
+            weights[batch++] = weights[i];
         }
+        starts.resize(batch), directions.resize(batch), weights.resize(batch);
         shadows.rays->Occluded(starts, directions, occluded);
-        for (std::size_t i = 0; i < starts.size(); ++i) {
+        for (std::size_t i = 0; i < batch; ++i) {
             if (!occluded[i]) visible += weights[i];
         }
+        // Where no point of its organs was lit past them, what passes rays from its points
+        // where they leave its box.
+        if (organs.total <= 0.0 && !closedRays.empty()) {
+            starts.clear(), directions.clear();
+            for (const ClosedRay& ray : closedRays) {
+                const double exit = occlusion_.ChordOf(ray.closed, ray.origin, ray.direction).exit;
+                starts.push_back(
+                    {ray.origin + shadows.offset + std::max(exit, 0.0) * ray.direction});
+                directions.push_back(ray.direction);
+            }
+            shadows.rays->Occluded(starts, directions, occluded);
+            for (std::uint8_t blocked : occluded) {
+                boxes.total += 1.0;
+                if (!blocked) boxes.visible += 1.0;
+            }
+        }
+        const Tally& closedSight = organs.total > 0.0 ? organs : boxes;
+        if (closedSight.total > 0.0)
+            visible += closedWeight * closedSight.visible / closedSight.total;
         return total > 0.0 ? visible / total : 0.0;
     }
     // Light that arrived on an opened instance meets its contents alone.

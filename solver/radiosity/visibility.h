@@ -126,11 +126,34 @@ class LinkVisibility {
     // patch. The points lie on a rank-1 lattice, which resolves a shadow edge across r in
     // both coordinates: stratified along one alone, the 10,000-leaf tree's PAR was 1.81 %
     // off the reference (L2, HRC at ε = 1e-4), 1.20 % now, for the same rays.
-    // `set` picks the stream of rays, as for links between nodes.
+    // `set` picks the stream of rays, as for links between nodes; `rounds`: so many lattices
+    // of rays, each shifted at random, together.
+    // Through the whole scene's triangles (ShadowView), a closed instance's visibility is the
+    // share of the light on its organs, lit past their own selves, that the rest of the scene
+    // lets through: points of its organs (ClosedOrganLight), each weighted by its triangle's
+    // area across the light, lit past everything over those lit past its own organs (what
+    // they take of one another's light is in its phase function). Taken from where rays from
+    // points of its box left the box, a neighbour's leaves inside the box never shaded it: in
+    // the stand scenario at cycle 20 the middle plant, solved whole, took 4.3 times the
+    // reference's light, and three crowns grown into one another 6 to 13 % too much direct
+    // light (Instanced.PlantsSolvedWholeInEachOthersCrownsTakeTheirShade); along lines through
+    // the box to the first organ each meets, the few lines that meet a sparse crown's organs
+    // left it 5 % off.
     double FromSource(std::uint32_t r, std::uint32_t source, const DirectionalSource& light,
-                      RaySet set, std::int64_t& rays) const;
+                      RaySet set, std::int64_t& rays, int rounds = 1) const;
 
   private:
+    // The direct light on a point of closed instance c's organs from a light (unit
+    // `toward`), in the whole scene's shadow engine, drawn from point x of its box
+    // (Hierarchy::SampleClosed's three coordinates): one of its organs' triangles taken
+    // evenly, a point of it, weighted by the triangle's area across the light; whether the
+    // point is lit past the instance's own organs, and past everything of the scene.
+    struct OrganLight {
+        double weight = 0.0;
+        bool ownLit = false, lit = false;
+    };
+    OrganLight ClosedOrganLight(std::int32_t c, const glm::dvec3& x,
+                                const glm::dvec3& toward) const;
     Sight BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
                          LinkRays& tally, int upTo) const;
     // What passes along a link's ray from p, `length` long, towards an end inside closed

@@ -108,6 +108,10 @@ class Occlusion {
         glm::dvec3 direction;
     };
     Chord ChordOf(std::uint32_t c, const glm::dvec3& origin, const glm::dvec3& direction) const;
+    // Point x of the scene in closed instance c's frame.
+    glm::dvec3 InInstance(std::uint32_t c, const glm::dvec3& x) const {
+        return glm::dvec3(boxes_[c].instanceFromScene * glm::dvec4(x, 1.0));
+    }
 
     std::size_t ProxyCount() const { return proxies_.size(); }
     // A local problem's, with the level it was opened in around it.

@@ -36,6 +36,7 @@ struct StartContext {
     const RayScene::Group* group = nullptr;
     std::uint32_t limit = kNoTriangle;
     const RayScene::TriangleRanges* skip = nullptr;  // triangles that do not count
+    const RayScene::TriangleRanges* only = nullptr;  // the only triangles that count
 };
 
 void IgnoreStartTriangle(const RTCFilterFunctionNArguments* args) {
@@ -43,13 +44,15 @@ void IgnoreStartTriangle(const RTCFilterFunctionNArguments* args) {
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
         const unsigned triangle = RTCRayN_id(args->ray, args->N, i);
-        if (triangle == kNoTriangle && !start->group && start->limit == kNoTriangle && !start->skip)
+        if (triangle == kNoTriangle && !start->group && start->limit == kNoTriangle &&
+            !start->skip && !start->only)
             continue;
         const unsigned instance = RTCHitN_instID(args->hit, args->N, i, 0);
         const int copy = instance == RTC_INVALID_GEOMETRY_ID ? 0 : static_cast<int>(instance);
         const unsigned primitive = RTCHitN_primID(args->hit, args->N, i);
         if (primitive >= start->limit) args->valid[i] = 0;
         if (start->skip && RayScene::InRanges(*start->skip, primitive)) args->valid[i] = 0;
+        if (start->only && !RayScene::InRanges(*start->only, primitive)) args->valid[i] = 0;
         if (primitive == triangle && copy == start->copy) args->valid[i] = 0;
         if (const RayScene::Group* group = start->group) {
             const std::uint32_t rank = group->rank[primitive];
@@ -152,6 +155,7 @@ void RayScene::BuildMesh(std::size_t triangles, std::size_t vertices, const Plac
             rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                     3 * sizeof(std::uint32_t), triangles));
         place(xyz, indices);
+        xyz_ = xyz, indices_ = indices;
         rtcSetGeometryIntersectFilterFunction(geometry, IgnoreStartTriangle);
         rtcSetGeometryOccludedFilterFunction(geometry, IgnoreStartTriangle);
         rtcCommitGeometry(geometry);
@@ -311,6 +315,16 @@ bool RayScene::OccludedByFirst(const RayStart& start, const glm::dvec3& directio
     StartContext context = MakeContext(0);
     context.limit = triangles;
     context.skip = skip != nullptr && !skip->empty() ? skip : nullptr;
+    RTCRay ray = EmbreeRay(start, direction, maxDistance);
+    rtcOccluded1(top_, &context.context, &ray);
+    return ray.tfar < 0.0f;
+}
+
+bool RayScene::OccludedAmong(const RayStart& start, const glm::dvec3& direction, double maxDistance,
+                             const TriangleRanges& only) const {
+    LEAFLUX_CHECK(!periodic_);
+    StartContext context = MakeContext(0);
+    context.only = &only;
     RTCRay ray = EmbreeRay(start, direction, maxDistance);
     rtcOccluded1(top_, &context.context, &ray);
     return ray.tfar < 0.0f;

@@ -114,6 +114,19 @@ class RayScene {
     // periodic.
     bool OccludedByFirst(const RayStart& start, const glm::dvec3& direction, double maxDistance,
                          std::uint32_t triangles, const TriangleRanges* skip = nullptr) const;
+    // Whether a triangle of `only` lies along the ray within maxDistance, the others passed.
+    // Not periodic.
+    bool OccludedAmong(const RayStart& start, const glm::dvec3& direction, double maxDistance,
+                       const TriangleRanges& only) const;
+    // The corners of triangle t, in the frame its rays are traced in (not periodic copies).
+    std::array<glm::dvec3, 3> Corners(std::uint32_t t) const {
+        std::array<glm::dvec3, 3> corners;
+        for (int k = 0; k < 3; ++k) {
+            const float* v = xyz_ + 3 * static_cast<std::size_t>(indices_[3 * std::size_t{t} + k]);
+            corners[k] = glm::dvec3(v[0], v[1], v[2]);
+        }
+        return corners;
+    }
 
     // A group of triangles: those whose rank (an index by triangle) lies in [first, last).
     struct Group {
@@ -145,8 +158,10 @@ class RayScene {
     const FlatScene& flat_;
     std::optional<PeriodicDomain> periodic_;
     std::shared_ptr<RayDevice> device_;
-    RTCScene mesh_ = nullptr;  // the triangles
-    RTCScene top_ = nullptr;   // the triangles, or 9 instances of them in a periodic scene
+    RTCScene mesh_ = nullptr;     // the triangles
+    RTCScene top_ = nullptr;      // the triangles, or 9 instances of them in a periodic scene
+    const float* xyz_ = nullptr;  // the triangles' vertices, 3 floats each
+    const std::uint32_t* indices_ = nullptr;  // and their 3 vertex indices each
 };
 
 // The scene's triangles in a ray engine, numbered as Flatten numbers them, in the frame of
