@@ -15,8 +15,8 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
     solve.add_option("--policy", command.policy,
                      "instanced: instantiation policy file (protobuf text format, "
                      "leaflux.v1.InstancingPolicy); default: the built-in general policy, "
-                     "plants and axes of more than 10 leaves by their leaf count in orders of "
-                     "magnitude");
+                     "plants and axes of more than 10 leaves by their leaf count, in steps of "
+                     "√2 up to 1,000 leaves");
     solve
         .add_option("--phase-db", command.phaseDb,
                     "instanced: phase-function database file, read and extended")

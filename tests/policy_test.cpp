@@ -103,9 +103,12 @@ TEST(PolicyFile, ShippedPoliciesParseAndValidate) {
     const InstancingPolicy general = LoadPolicyFile(PolicyPath("default.txtpb"));
     // Structures of 10 leaves or fewer are left to the structure that holds them; the
     // policy of every structure bins them too.
-    EXPECT_EQ(general.leafCount.edges, (std::vector<double>{11, 100, 1000, 10000}));
-    EXPECT_EQ(LoadPolicyFile(PolicyPath("every_structure.txtpb")).leafCount.edges,
-              (std::vector<double>{1, 10, 100, 1000, 10000}));
+    const std::vector<double> steps{11,  16,  23,  32,  45,  64,   91,   128,
+                                    181, 256, 362, 512, 724, 1000, 10000};
+    EXPECT_EQ(general.leafCount.edges, steps);
+    std::vector<double> every{1, 2, 3, 4, 6, 8};
+    every.insert(every.end(), steps.begin(), steps.end());
+    EXPECT_EQ(LoadPolicyFile(PolicyPath("every_structure.txtpb")).leafCount.edges, every);
     ASSERT_NE(general.FixedFor(NodeType::kAxis), nullptr);
     EXPECT_EQ(general.FixedFor(NodeType::kAxis)->leafCountAbove, 10000);
     EXPECT_NE(PolicyContentHash(general),
@@ -351,8 +354,8 @@ instance_types: NODE_TYPE_AXIS   # one at a time, in another order
 instance_types: NODE_TYPE_PLANT
 by_type: true
 leaf_count {
-  edges: 11 edges: 100
-  edges: [1000, 1e4]
+  edges: 11 edges: 16 edges: 23 edges: 32
+  edges: [45, 64, 91, 128, 181, 256, 362, 512, 724, 1000, 1e4]
 }
 fixed { type: NODE_TYPE_AXIS leaf_count_above: 10000 }
 fixed { type: NODE_TYPE_PLANT leaf_count_above: 10000 }
@@ -362,7 +365,7 @@ phase { level: 3 kind: FUNCTION_KIND_BI }
     EXPECT_EQ(PolicyContentHash(LoadPolicyFile(path)), PolicyContentHash(shipped));
     const std::string changed = WriteTempFile("changed_policy.txtpb", R"(
 species: "default" instance_types: [NODE_TYPE_PLANT, NODE_TYPE_AXIS] by_type: true
-leaf_count { edges: [11, 100, 1000, 10000] }
+leaf_count { edges: [11, 16, 23, 32, 45, 64, 91, 128, 181, 256, 362, 512, 724, 1000, 10000] }
 fixed { type: NODE_TYPE_PLANT leaf_count_above: 10000 }
 fixed { type: NODE_TYPE_AXIS leaf_count_above: 10001 }
 phase { kind: FUNCTION_KIND_BI direction_count: 130 }
