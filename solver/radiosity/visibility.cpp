@@ -364,7 +364,6 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
         std::size_t batch = 0;  // the rays traced together, moved to the front
         for (std::size_t i = 0; i < starts.size(); ++i) {
             total += weights[i];
-            const glm::dvec3 from = starts[i].origin + shadows.offset;
             if (closed[i] >= 0) {
                 closedWeight += weights[i];
                 const OrganLight organ =
@@ -376,7 +375,8 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
                 closedRays.push_back({starts[i].origin, directions[i], closed[i]});
                 continue;
             }
-            starts[batch] = {from, shadows.triangleOf[starts[i].triangle]};
+            starts[batch] = {starts[i].origin + shadows.offset,
+                             shadows.triangleOf[starts[i].triangle]};
             directions[batch] = directions[i];
             weights[batch++] = weights[i];
         }
