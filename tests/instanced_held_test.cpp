@@ -159,17 +159,39 @@ TEST(Instanced, TheLampsLightOnTheClosedPlantsIsIncident) {
 // the sender's rays the receiver's box stops (closed_exchange.h), 6.0 and 13.6 % less;
 // the other copy held and linked into the opened one's leaves from all round them
 // (HeldAroundLinks), its light leaving evenly from its box, 3.5 and 7.1 % less; leaving
-// from where its organs lie (AreaGrid), 0.4 % less and 1.0 % more (the test prints them).
-// The bounds, 2 and 3 %, hold what was gained.
+// from where its organs lie (AreaGrid), 0.8 % less and as much; each group's points
+// weighted by their area facing the light, seen as far as points spread over the organs
+// behind them, and the light not dimmed by the organs ahead of them, 0.4 % less and 1.3 %
+// more (the test prints them). The bounds, 2 and 3 %, hold what was gained.
 TEST(Instanced, OverlappingCrownsExchangeTheirScatteredLight) {
     ExpectLowerSidesNearFlattened(Copies(2, 300, 0.3), {0.02, 0.03});
+}
+
+// A tree whose branches are instances: each opened branch takes the light of the others,
+// whose boxes wrap its leaves, from all around them (HeldAroundLinks). Each group of leaves
+// took the mean of its points' light, its lower sides' NIR 3.24 % short of the flattened
+// scene's (ε = 1e-4, the ten 1,000-leaf branches of a 10,000-leaf tree): points on leaves
+// seen edge-on from where the light comes, shaded by the leaves beside them, counted as
+// much as those facing it. Weighted by their area facing the light, as a link's rays are,
+// 1.24 % short; with the light not yet dimmed by the held branch's organs ahead of the
+// point, which its intensity holds, 0.46 %; seen as far as points spread over the organs
+// behind, not their centre, 0.34 % (upper sides 0.61 % short before, 0.20 % now; the test
+// prints them). Bounds: 1 % (upper), 1.5 % (lower).
+TEST(Instanced, BranchesHeldAroundOneAnotherLightTheLeavesTheyWrap) {
+    InstancingPolicy branches = Plants();
+    branches.instanceTypes = {NodeType::kAxis};
+    branches.leafCount.edges = {724, 1001};  // the ten branches of 1,000 leaves
+    branches.phase = {PhaseKind::kBiDirectional, 3};
+    ExpectSidesNearFlattened(Copies(1, 10000), 1e-4,
+                             {std::vector<double>{0.01, 0.01}, std::vector<double>{0.015, 0.015}},
+                             branches);
 }
 
 // Organs among a held instance's leaves take its light in groups, each the mean over its
 // points (HeldAroundLinks). That light changes from organ to organ with the depth of the
 // held instance's organs behind each, so groups are split while it is more than a link may
 // carry (Refiner::HeldAroundLight). Three copies whose crowns grow into one another, at
-// ε = 1e-4: the leaves' sides are 1.27 % of the brightest off the flattened scene's NIR
+// ε = 1e-4: the leaves' sides are 1.26 % of the brightest off the flattened scene's NIR
 // (RMS; HRC at 1e-5) so, 1.49 % in groups of half the held radius (the test prints it).
 // Bound: 1.35 %.
 TEST(Instanced, OrgansAmongAHeldCrownTakeItsLightSideBySide) {

@@ -1,6 +1,7 @@
 #include "solver/radiosity/closed_exchange.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -13,6 +14,9 @@ namespace {
 // Points of a box spread evenly through it: the centres of a 4 × 4 × 4 grid of its cells;
 // a receiver's in HeldAroundLinks, the centres of a 4 × 4 grid over it.
 constexpr int kCells = 4;
+// The least transmittance a held instance's light is taken to have passed on its way out of
+// its box, and the deepest optical depth it is taken to have crossed there (a factor 20).
+constexpr double kLeastTransmittance = 0.05, kDeepest = 3.0;
 
 // The share of the line x + t ω, t ≥ 0, of the box [lo, hi] (instance frame) over its whole
 // chord; 0 when the line misses it.
@@ -26,11 +30,18 @@ double ChordShare(const glm::dvec3& x, const glm::dvec3& omega, const glm::dvec3
 }  // namespace
 
 Emitters EmittersAlong(const ClosedNode& sender, const glm::dvec3& x, const glm::dvec3& along,
-                       double from, double to, double volume) {
+                       double from, double to, double volume, double share) {
     const double length = to - from;
-    if (!sender.organArea) return {length / volume, from + 0.5 * length};
-    // The line walked cell by cell (Amanatides & Woo 1987), each piece taken whole.
+    if (!(length > 0.0)) return {};
+    if (!sender.organArea) return {length / volume, from + share * length};
+    // The line walked cell by cell (Amanatides & Woo 1987), each piece taken whole: at most
+    // one piece per cell plane crossed.
     constexpr int kSide = AreaGrid::kCells;
+    struct Piece {
+        double from, to, integral;
+    };
+    std::array<Piece, 3 * kSide + 1> pieces;
+    std::size_t count = 0;
     const glm::dvec3 cell = (sender.boxMax - sender.boxMin) / static_cast<double>(kSide);
     const glm::dvec3 start = x + from * along;
     glm::ivec3 at, step;
@@ -49,22 +60,33 @@ Emitters EmittersAlong(const ClosedNode& sender, const glm::dvec3& x, const glm:
     }
     const double perCell = static_cast<double>(AreaGrid::kCount) / volume;
     Emitters e;
-    for (double t = from; t < to;) {
+    for (double t = from; t < to && count < pieces.size();) {
         const int a = next.x <= next.y ? (next.x <= next.z ? 0 : 2) : (next.y <= next.z ? 1 : 2);
         const double exit = std::min(next[a], to);
         if (exit > t) {
             const int c = AreaGrid::Index(at.x, at.y, at.z);
             const double piece =
                 static_cast<double>(sender.organArea->share[c]) * perCell * (exit - t);
+            pieces[count++] = {t, exit, piece};
             e.integral += piece;
-            e.distance += piece * 0.5 * (t + exit);
         }
         t = exit;
         at[a] += step[a];
         if (at[a] < 0 || at[a] >= kSide) break;
         next[a] += delta[a];
     }
-    if (e.integral > 0.0) e.distance /= e.integral;
+    // Where the share of the integral is reached, within its piece's even density.
+    double before = 0.0;
+    const double target = share * e.integral;
+    for (std::size_t k = 0; k < count; ++k) {
+        const Piece& piece = pieces[k];
+        e.distance = piece.to;
+        if (piece.integral > 0.0 && before + piece.integral >= target) {
+            e.distance = piece.from + (target - before) / piece.integral * (piece.to - piece.from);
+            break;
+        }
+        before += piece.integral;
+    }
     return e;
 }
 
@@ -154,22 +176,44 @@ std::vector<NodeLink> HeldAroundLinks(
         const glm::dvec3& omega = directions.Direction(d);  // the way the light goes
         const glm::dvec3 back = linear * -omega;            // towards where it comes from
         double behind = 0.0;  // the mean ∫ e dℓ (1/m²), as far as seen from the point
+        // The light arriving inside the box is not yet dimmed by the organs it has still to
+        // pass on its way out, which I(ω) holds: per unit of ∫ e dℓ between the point and
+        // where the light leaves the box, the box's mean optical depth along ω, −ln τ(ω)
+        // over its section A⊥ (for which ∫ e dℓ is 1 / A⊥ on the mean).
+        const double depth =
+            -std::log(std::clamp(sender.contents->Transmittance(sender.ToInstance(omega)),
+                                 kLeastTransmittance, 1.0)) *
+            sender.BoxProjectedArea(omega);
         // A point of each row of r's grid, in a column that turns with the bin: each bin
         // sees r's whole extent, and the bins together every point.
+        double weights = 0.0;
         for (int row = 0; row < kCells; ++row) {
-            const std::size_t i = row * kCells + (row + d) % kCells;
+            const int column = (row + d) % kCells;
+            const std::size_t i = row * kCells + column;
+            // Each point by its area facing the light, as a link's rays are (Between).
+            const double weight = model.ReceivingWeight(at[i].triangle, at[i].normal, -omega);
+            weights += weight;
+            if (weight <= 0.0) continue;
             const BoxSpan span = LineThroughBox(points[i], back, sender.boxMin, sender.boxMax);
             if (!span.Meets() || span.exit <= 0.0) continue;
             const double from = std::max(span.enter, 0.0);
-            const Emitters behindPoint =
-                EmittersAlong(sender, points[i], back, from, span.exit, volume);
+            // Seen as far as a point of the emitters behind, a share (column + ½) / kCells
+            // of them nearer: the organs between stop the light of the nearer ones less
+            // than that of the farther, and a ray to where they are centred took the
+            // farther ones' share for all of them.
+            const Emitters behindPoint = EmittersAlong(sender, points[i], back, from, span.exit,
+                                                       volume, (column + 0.5) / kCells);
             if (behindPoint.integral <= 0.0) continue;
-            // Seen as far as where the light it meets leaves from, on the whole.
+            const double ahead =
+                span.enter < 0.0
+                    ? EmittersAlong(sender, points[i], back, span.enter, 0.0, volume).integral
+                    : 0.0;
             ++rays;
-            behind += behindPoint.integral * passed(at[i], -omega, behindPoint.distance);
+            behind += weight * behindPoint.integral * std::exp(std::min(depth * ahead, kDeepest)) *
+                      passed(at[i], -omega, behindPoint.distance);
         }
-        behind /= static_cast<double>(kCells);
         if (behind <= 0.0) continue;
+        behind /= weights;
         NodeLink link;
         link.sender = s;
         link.ownRays = true;  // its rays traced here

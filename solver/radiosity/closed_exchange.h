@@ -22,14 +22,15 @@ namespace leaflux {
 // Where the light a closed instance sends along the line x + t ω leaves from (instance
 // frame), between distances `from` and `to` along it: ∫ e dℓ, e the share of its light
 // leaving per m³ (its organs' area share per cell of its AreaGrid over the cell's part of
-// `volume`; 1 / `volume` without a grid), and the distance that integral is centred on.
-// Exact: the density is constant in each cell, and the line is walked cell by cell.
+// `volume`; 1 / `volume` without a grid), and the distance by which `share` of that
+// integral lies (½: its median). Exact: the density is constant in each cell, and the line
+// is walked cell by cell.
 struct Emitters {
     double integral = 0.0;  // 1/m²
     double distance = 0.0;  // m
 };
 Emitters EmittersAlong(const ClosedNode& sender, const glm::dvec3& x, const glm::dvec3& along,
-                       double from, double to, double volume);
+                       double from, double to, double volume, double share = 0.5);
 
 // Whether two nodes' bounding spheres overlap.
 bool BoundsOverlap(const HrcNode& a, const HrcNode& b);
