@@ -175,7 +175,9 @@ std::vector<NodeLink> HeldAroundLinks(
     for (int d = 0; d < directions.Size(); ++d) {
         const glm::dvec3& omega = directions.Direction(d);  // the way the light goes
         const glm::dvec3 back = linear * -omega;            // towards where it comes from
-        double behind = 0.0;  // the mean ∫ e dℓ (1/m²), as far as seen from the point
+        // The mean over r's points, by their area facing the light, of ∫ e dℓ (1/m²) as far
+        // as seen from each.
+        double behind = 0.0;
         // The light arriving inside the box is not yet dimmed by the organs it has still to
         // pass on its way out, which I(ω) holds: per unit of ∫ e dℓ between the point and
         // where the light leaves the box, the box's mean optical depth along ω, −ln τ(ω)
