@@ -29,6 +29,7 @@ void PrintPolicy(const InstancingPolicy& policy, std::ostream& out) {
     out << "\n  signature:" << (policy.byType ? " type" : "");
     if (policy.leafCount.Used()) out << " leaf_count(" << policy.leafCount.Count() << " bins)";
     if (policy.age.Used()) out << " age(" << policy.age.Count() << " bins)";
+    if (policy.inclination.Used()) out << " inclination(" << policy.inclination.Count() << " bins)";
     for (const AttributeBins& attribute : policy.attributes) {
         out << ' ' << attribute.name << '(' << attribute.bins.Count() << " bins)";
     }

@@ -94,6 +94,8 @@ InstancingPolicy PolicyFromProto(const v1::InstancingPolicy& message) {
     policy.byType = message.by_type();
     policy.leafCount = BinsFromProto(message.has_leaf_count(), message.leaf_count(), "leaf_count");
     policy.age = BinsFromProto(message.has_age(), message.age(), "age");
+    policy.inclination =
+        BinsFromProto(message.has_inclination(), message.inclination(), "inclination");
     for (const v1::AttributeBins& attribute : message.attributes()) {
         policy.attributes.push_back(
             {attribute.name(), Bins{{attribute.edges().begin(), attribute.edges().end()}}});

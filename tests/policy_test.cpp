@@ -10,8 +10,10 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <random>
 #include <set>
 #include <unordered_map>
@@ -89,7 +91,8 @@ Scene GeneratedTree(int leaves, std::uint64_t seed = 3) {
 }
 
 TEST(PolicyFile, ShippedPoliciesParseAndValidate) {
-    for (const char* name : {"default.txtpb", "every_structure.txtpb", "generated_tree.txtpb"}) {
+    for (const char* name : {"default.txtpb", "every_structure.txtpb", "generated_tree.txtpb",
+                             "by_inclination.txtpb"}) {
         SCOPED_TRACE(name);
         const InstancingPolicy policy = LoadPolicyFile(PolicyPath(name));
         EXPECT_NO_THROW(ValidatePolicy(policy));
@@ -113,6 +116,11 @@ TEST(PolicyFile, ShippedPoliciesParseAndValidate) {
     EXPECT_EQ(general.FixedFor(NodeType::kAxis)->leafCountAbove, 10000);
     EXPECT_NE(PolicyContentHash(general),
               PolicyContentHash(LoadPolicyFile(PolicyPath("generated_tree.txtpb"))));
+    // The default policy, its structures binned by their inclination too.
+    const InstancingPolicy inclined = LoadPolicyFile(PolicyPath("by_inclination.txtpb"));
+    EXPECT_EQ(inclined.leafCount.edges, steps);
+    EXPECT_EQ(inclined.inclination.edges, (std::vector<double>{0, 30, 60, 90, 120, 150, 180}));
+    EXPECT_FALSE(general.inclination.Used());
 }
 
 TEST(PolicyFile, UnknownFieldNamesFileLineAndColumn) {
@@ -207,6 +215,11 @@ TEST(PolicyValidation, OverlappingBinsAreRefused) {
     policy = Minimal();
     policy.age.edges = {0, std::numeric_limits<double>::infinity()};
     EXPECT_EQ(PolicyError(policy).Field(), "age.edges[1]");
+    policy = Minimal();
+    policy.inclination.edges = {0, 90, 200};  // an angle from the world's up: 0 to 180
+    EXPECT_EQ(PolicyError(policy).Field(), "inclination.edges[2]");
+    policy.inclination.edges = {-10, 90};
+    EXPECT_EQ(PolicyError(policy).Field(), "inclination.edges[0]");
 }
 
 TEST(PolicyValidation, BadLevelsAndKindsAreRefused) {
@@ -313,6 +326,12 @@ TEST(PolicyHash, ChangesWithEveryField) {
         [](auto& p) { p.leafCount.edges.clear(); },
         [](auto& p) { p.age.edges[1] = 1.5; },
         [](auto& p) { p.age.edges.clear(); },
+        [](auto& p) {
+            p.inclination.edges = {0, 90, 180};
+        },
+        [](auto& p) {
+            p.inclination.edges = {0, 60, 180};
+        },
         [](auto& p) { p.attributes[0].name = "rank"; },
         [](auto& p) { p.attributes[0].bins.edges[1] = 2; },
         [](auto& p) {
@@ -535,6 +554,38 @@ TEST(SignatureOnGeneratedTree, ReadableSignaturesAndUnbinnedStructures) {
         }
     }
     EXPECT_EQ(unbinned, 2);  // the plant and its trunk
+}
+
+// The inclination is each structure's frame's z against the world's up, its frames
+// composed from the root: the same for the tree turned about the vertical, 180° less
+// itself for the tree upside down.
+TEST(SignatureOnGeneratedTree, InclinationIsEachStructuresAngleFromTheWorldsUp) {
+    const Scene scene = GeneratedTree(1000);
+    InstancingPolicy policy = Minimal();
+    policy.inclination.edges = {0, 30, 60, 90, 120, 150, 180};
+    const SceneSignatures base = ComputeSignatures(scene, policy);
+    const auto turned = [&](const glm::dmat4& motion) {
+        Scene moved = scene;
+        for (Node& node : moved.nodes) {
+            if (node.parent == kNoParent)
+                node.parentFromLocal = motion * glm::dmat4(node.parentFromLocal);
+        }
+        return ComputeSignatures(moved, policy);
+    };
+    const SceneSignatures about = turned(glm::rotate(glm::dmat4(1.0), 1.1, {0.0, 0.0, 1.0}));
+    const SceneSignatures over =
+        turned(glm::rotate(glm::dmat4(1.0), std::numbers::pi, {1.0, 0.0, 0.0}));
+    std::set<int> bins;
+    ASSERT_EQ(about.structures.size(), base.structures.size());
+    for (std::size_t i = 0; i < base.structures.size(); ++i) {
+        const StructureSignature& s = base.structures[i];
+        EXPECT_NEAR(about.structures[i].inclination, s.inclination, 1e-4);
+        EXPECT_EQ(about.structures[i].signature, s.signature);
+        EXPECT_NEAR(over.structures[i].inclination, 180.0 - s.inclination, 1e-4);
+        bins.insert(s.inclinationBin);
+    }
+    EXPECT_NEAR(base.structures.front().inclination, 0.0, 1e-6);  // the plant stands upright
+    EXPECT_GE(bins.size(), 3u) << "its branches and shoots lean every way";
 }
 
 }  // namespace

@@ -125,6 +125,13 @@ void ValidatePolicy(const InstancingPolicy& policy) {
     }
     ValidateBins(policy.leafCount, "leaf_count", true);
     ValidateBins(policy.age, "age", false);
+    ValidateBins(policy.inclination, "inclination", false);
+    for (std::size_t i = 0; i < policy.inclination.edges.size(); ++i) {
+        if (policy.inclination.edges[i] < 0.0 || policy.inclination.edges[i] > 180.0) {
+            Fail(ErrorCode::kInvalidArgument, "inclination.edges[" + std::to_string(i) + "]",
+                 "lies outside 0 to 180 degrees: an angle from the world's up");
+        }
+    }
     std::set<std::string> names;
     for (std::size_t i = 0; i < policy.attributes.size(); ++i) {
         const AttributeBins& attribute = policy.attributes[i];
@@ -149,7 +156,7 @@ void ValidatePolicy(const InstancingPolicy& policy) {
         ValidateBins(attribute.bins, field, false);
     }
     if (!policy.byType && !policy.leafCount.Used() && !policy.age.Used() &&
-        policy.attributes.empty()) {
+        !policy.inclination.Used() && policy.attributes.empty()) {
         Fail(ErrorCode::kInvalidArgument, "by_type",
              "is false and no value is binned: the signature would be made of nothing");
     }
@@ -191,6 +198,7 @@ std::string PolicyContentHash(const InstancingPolicy& policy) {
     hash.Add(static_cast<int>(policy.byType));
     AddBins(hash, policy.leafCount);
     AddBins(hash, policy.age);
+    if (policy.inclination.Used()) AddBins(hash, policy.inclination);  // older policies' hash kept
     std::vector<const AttributeBins*> attributes;
     for (const AttributeBins& attribute : policy.attributes) attributes.push_back(&attribute);
     std::sort(attributes.begin(), attributes.end(),

@@ -55,6 +55,8 @@ struct InstancingPolicy {
     bool byType = true;                   // the node type is part of the signature
     Bins leafCount;                       // leaf organs in the structure's subtree
     Bins age;                             // the node's physiological age
+    // The angle (degrees) between the structure's frame's z and the world's up (+z).
+    Bins inclination;
     std::vector<AttributeBins> attributes;
     std::vector<FixedFunction> fixed;  // at most one per instance type
     FunctionResolution phase;

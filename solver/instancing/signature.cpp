@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <glm/glm.hpp>
 #include <numeric>
 #include <span>
 #include <sstream>
@@ -15,9 +16,15 @@ namespace {
 
 bool IsLeafOrgan(const Node& node) { return node.type == NodeType::kLeaf && node.organ; }
 
-// Leaf organs in each node's subtree, by position in scene.nodes: a breadth-first order
-// from the roots, then sums from the last node back to the roots.
-std::vector<std::int64_t> SubtreeLeafCounts(const Scene& scene) {
+// Per node, by position in scene.nodes: the leaf organs in its subtree, and the angle
+// (degrees) between its frame's z and the world's up. A breadth-first order from the roots
+// takes each node's world frame from its parent's; sums from the last node back to the
+// roots take the leaves.
+struct NodeFacts {
+    std::vector<std::int64_t> leaves;
+    std::vector<double> inclination;
+};
+NodeFacts FactsOf(const Scene& scene) {
     const std::size_t n = scene.nodes.size();
     const Topology topology(scene);
     std::vector<std::uint32_t> order = topology.Roots();
@@ -27,12 +34,23 @@ std::vector<std::int64_t> SubtreeLeafCounts(const Scene& scene) {
         order.insert(order.end(), children.begin(), children.end());
     }
     LEAFLUX_CHECK(order.size() == n);  // a validated scene is a forest
-    std::vector<std::int64_t> leaves(n, 0);
-    for (auto k = order.rbegin(); k != order.rend(); ++k) {
-        if (IsLeafOrgan(scene.nodes[*k])) ++leaves[*k];
-        if (topology.Parent(*k) != Topology::kNone) leaves[topology.Parent(*k)] += leaves[*k];
+    NodeFacts facts{std::vector<std::int64_t>(n, 0), std::vector<double>(n, 0.0)};
+    std::vector<glm::dmat3> world(n);
+    for (const std::uint32_t i : order) {
+        const glm::dmat3 local(glm::dmat4(scene.nodes[i].parentFromLocal));
+        const std::uint32_t parent = topology.Parent(i);
+        world[i] = parent == Topology::kNone ? local : world[parent] * local;
+        const double length = glm::length(world[i][2]);
+        facts.inclination[i] =
+            length > 0.0 ? glm::degrees(std::acos(std::clamp(world[i][2].z / length, -1.0, 1.0)))
+                         : 0.0;
     }
-    return leaves;
+    for (auto k = order.rbegin(); k != order.rend(); ++k) {
+        if (IsLeafOrgan(scene.nodes[*k])) ++facts.leaves[*k];
+        if (topology.Parent(*k) != Topology::kNone)
+            facts.leaves[topology.Parent(*k)] += facts.leaves[*k];
+    }
+    return facts;
 }
 
 // Bins `value` for one part of the signature; false (and the reason) when it has none.
@@ -55,7 +73,7 @@ bool AddPart(std::string& signature, std::string& unbinned, const Bins& bins,
     return true;
 }
 
-StructureSignature Classify(const Node& node, std::int64_t leafCount,
+StructureSignature Classify(const Node& node, std::int64_t leafCount, double inclination,
                             const InstancingPolicy& policy,
                             const std::vector<std::size_t>& attributesByName) {
     StructureSignature s;
@@ -63,6 +81,7 @@ StructureSignature Classify(const Node& node, std::int64_t leafCount,
     s.type = node.type;
     s.leafCount = leafCount;
     s.age = node.age;
+    s.inclination = inclination;
     s.attributeBins.assign(policy.attributes.size(), -1);
     for (const AttributeBins& attribute : policy.attributes) {
         const auto found = node.attributes.find(attribute.name);
@@ -85,6 +104,10 @@ StructureSignature Classify(const Node& node, std::int64_t leafCount,
     }
     if (binned && policy.age.Used()) {
         binned = AddPart(signature, s.unbinned, policy.age, "age", "age", node.age, s.ageBin);
+    }
+    if (binned && policy.inclination.Used()) {
+        binned = AddPart(signature, s.unbinned, policy.inclination, "incl", "inclination",
+                         inclination, s.inclinationBin);
     }
     // Attributes by name, so that their order in the policy file does not change signatures
     // (PolicyContentHash ignores that order too).
@@ -137,7 +160,7 @@ SceneSignatures ComputeSignatures(const Scene& scene, const InstancingPolicy& po
         return policy.attributes[a].name < policy.attributes[b].name;
     });
 
-    const std::vector<std::int64_t> leaves = SubtreeLeafCounts(scene);
+    const NodeFacts facts = FactsOf(scene);
     SceneSignatures result;
     std::vector<bool> carried(policy.attributes.size(), false);
     for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
@@ -146,8 +169,9 @@ SceneSignatures ComputeSignatures(const Scene& scene, const InstancingPolicy& po
         for (std::size_t a = 0; a < policy.attributes.size(); ++a) {
             if (node.attributes.count(policy.attributes[a].name)) carried[a] = true;
         }
-        if (leaves[i] == 0) continue;  // nothing to light: never an instance
-        result.structures.push_back(Classify(node, leaves[i], policy, attributesByName));
+        if (facts.leaves[i] == 0) continue;  // nothing to light: never an instance
+        result.structures.push_back(
+            Classify(node, facts.leaves[i], facts.inclination[i], policy, attributesByName));
     }
     for (std::size_t a = 0; a < policy.attributes.size(); ++a) {
         if (!carried[a]) {
@@ -174,7 +198,8 @@ SceneSignatures ComputeSignatures(const Scene& scene, const InstancingPolicy& po
     // (the strings alone would put "leaves[1001" before "leaves[101").
     const auto key = [&](const SignatureGroup& group) {
         const StructureSignature& s = *result.Find(group.members.front());
-        std::vector<int> bins{static_cast<int>(s.type), s.fixed, s.leafBin, s.ageBin};
+        std::vector<int> bins{static_cast<int>(s.type), s.fixed, s.leafBin, s.ageBin,
+                              s.inclinationBin};
         for (const std::size_t a : attributesByName) bins.push_back(s.attributeBins[a]);
         return bins;
     };

@@ -26,15 +26,17 @@ struct StructureSignature {
     NodeType type = NodeType::kOther;
     std::int64_t leafCount = 0;  // leaf organs in the subtree, the node itself included
     double age = 0.0;            // physiological age
+    double inclination = 0.0;    // degrees between its frame's z and the world's up
     // Per policy attribute, in the policy's order: the node's value, if it has one.
     std::vector<std::optional<double>> attributes;
     // Bins of those values (-1: not binned by the policy, or outside every bin).
     int leafBin = -1;
     int ageBin = -1;
+    int inclinationBin = -1;
     std::vector<int> attributeBins;
     bool fixed = false;  // beyond its type's size cap: the type's one fixed original
-    // "axis|leaves[10,100)|age[2,5)", "axis|large"; empty when a value the policy bins is
-    // missing or outside its bins, so the structure is no instance (`unbinned` says why).
+    // "axis|leaves[10,100)|age[2,5)|incl[30,60)", "axis|large"; empty when a value the policy bins
+    // is missing or outside its bins, so the structure is no instance (`unbinned` says why).
     std::string signature;
     std::string unbinned;
 };
