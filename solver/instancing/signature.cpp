@@ -16,15 +16,15 @@ namespace {
 
 bool IsLeafOrgan(const Node& node) { return node.type == NodeType::kLeaf && node.organ; }
 
-// Per node, by position in scene.nodes: the leaf organs in its subtree, and the angle
-// (degrees) between its frame's z and the world's up. A breadth-first order from the roots
-// takes each node's world frame from its parent's; sums from the last node back to the
-// roots take the leaves.
+// Per node, by position in scene.nodes: the leaf organs in its subtree, and, when asked,
+// the angle (degrees) between its frame's z and the world's up. A breadth-first order from
+// the roots takes each node's world frame from its parent's; sums from the last node back
+// to the roots take the leaves.
 struct NodeFacts {
     std::vector<std::int64_t> leaves;
     std::vector<double> inclination;
 };
-NodeFacts FactsOf(const Scene& scene) {
+NodeFacts FactsOf(const Scene& scene, bool inclination) {
     const std::size_t n = scene.nodes.size();
     const Topology topology(scene);
     std::vector<std::uint32_t> order = topology.Roots();
@@ -34,16 +34,19 @@ NodeFacts FactsOf(const Scene& scene) {
         order.insert(order.end(), children.begin(), children.end());
     }
     LEAFLUX_CHECK(order.size() == n);  // a validated scene is a forest
-    NodeFacts facts{std::vector<std::int64_t>(n, 0), std::vector<double>(n, 0.0)};
-    std::vector<glm::dmat3> world(n);
-    for (const std::uint32_t i : order) {
-        const glm::dmat3 local(glm::dmat4(scene.nodes[i].parentFromLocal));
-        const std::uint32_t parent = topology.Parent(i);
-        world[i] = parent == Topology::kNone ? local : world[parent] * local;
-        const double length = glm::length(world[i][2]);
-        facts.inclination[i] =
-            length > 0.0 ? glm::degrees(std::acos(std::clamp(world[i][2].z / length, -1.0, 1.0)))
-                         : 0.0;
+    NodeFacts facts{std::vector<std::int64_t>(n, 0), std::vector<double>(inclination ? n : 0, 0.0)};
+    if (inclination) {
+        std::vector<glm::dmat3> world(n);  // 72 bytes a node, while classifying
+        for (const std::uint32_t i : order) {
+            const glm::dmat3 local(glm::dmat4(scene.nodes[i].parentFromLocal));
+            const std::uint32_t parent = topology.Parent(i);
+            world[i] = parent == Topology::kNone ? local : world[parent] * local;
+            const double length = glm::length(world[i][2]);
+            facts.inclination[i] =
+                length > 0.0
+                    ? glm::degrees(std::acos(std::clamp(world[i][2].z / length, -1.0, 1.0)))
+                    : 0.0;
+        }
     }
     for (auto k = order.rbegin(); k != order.rend(); ++k) {
         if (IsLeafOrgan(scene.nodes[*k])) ++facts.leaves[*k];
@@ -160,7 +163,7 @@ SceneSignatures ComputeSignatures(const Scene& scene, const InstancingPolicy& po
         return policy.attributes[a].name < policy.attributes[b].name;
     });
 
-    const NodeFacts facts = FactsOf(scene);
+    const NodeFacts facts = FactsOf(scene, policy.inclination.Used());
     SceneSignatures result;
     std::vector<bool> carried(policy.attributes.size(), false);
     for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
@@ -170,8 +173,9 @@ SceneSignatures ComputeSignatures(const Scene& scene, const InstancingPolicy& po
             if (node.attributes.count(policy.attributes[a].name)) carried[a] = true;
         }
         if (facts.leaves[i] == 0) continue;  // nothing to light: never an instance
-        result.structures.push_back(
-            Classify(node, facts.leaves[i], facts.inclination[i], policy, attributesByName));
+        result.structures.push_back(Classify(node, facts.leaves[i],
+                                             facts.inclination.empty() ? 0.0 : facts.inclination[i],
+                                             policy, attributesByName));
     }
     for (std::size_t a = 0; a < policy.attributes.size(); ++a) {
         if (!carried[a]) {
