@@ -17,12 +17,15 @@ grep -A1 -x 'axis|leaves\[8,11)' "$out/every.txt" | grep -q 'members 100, leaves
     fail "every-structure policy: the 100 shoots are not one group"
 grep -A1 -x 'axis|leaves\[91,128)' "$out/every.txt" | grep -q 'members 10,' ||
     fail "every-structure policy: the 10 branches are not one group"
-# The default leaves the shoots of 10 leaves to their branches.
+# The default leaves the shoots of 10 leaves to their branches, and bins the inclination:
+# the generated tree's branches all lean 30 to 60° from the vertical, its trunk stands.
 "$leaflux" policy check --policy "$policies/default.txtpb" --leaves 1000 > "$out/default.txt"
 grep -q '^112 instantiable structures, 3 groups, 100 in no bin' "$out/default.txt" ||
     fail "default policy: not 3 groups with the 100 shoots in no bin"
-grep -A1 -x 'axis|leaves\[91,128)' "$out/default.txt" | grep -q 'members 10,' ||
+grep -A1 -x 'axis|leaves\[91,128)|incl\[30,60)' "$out/default.txt" | grep -q 'members 10,' ||
     fail "default policy: the 10 branches are not one group"
+grep -qx 'axis|leaves\[1000,10000\]|incl\[0,30)' "$out/default.txt" ||
+    fail "default policy: the trunk is not upright"
 
 # Beyond the cap of 10^4 leaves, one fixed original per type.
 "$leaflux" policy check --policy "$policies/default.txtpb" --leaves 20000 > "$out/large.txt"

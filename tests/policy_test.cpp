@@ -92,7 +92,7 @@ Scene GeneratedTree(int leaves, std::uint64_t seed = 3) {
 
 TEST(PolicyFile, ShippedPoliciesParseAndValidate) {
     for (const char* name : {"default.txtpb", "every_structure.txtpb", "generated_tree.txtpb",
-                             "by_inclination.txtpb"}) {
+                             "no_inclination.txtpb"}) {
         SCOPED_TRACE(name);
         const InstancingPolicy policy = LoadPolicyFile(PolicyPath(name));
         EXPECT_NO_THROW(ValidatePolicy(policy));
@@ -116,11 +116,13 @@ TEST(PolicyFile, ShippedPoliciesParseAndValidate) {
     EXPECT_EQ(general.FixedFor(NodeType::kAxis)->leafCountAbove, 10000);
     EXPECT_NE(PolicyContentHash(general),
               PolicyContentHash(LoadPolicyFile(PolicyPath("generated_tree.txtpb"))));
-    // The default policy, its structures binned by their inclination too.
-    const InstancingPolicy inclined = LoadPolicyFile(PolicyPath("by_inclination.txtpb"));
-    EXPECT_EQ(inclined.leafCount.edges, steps);
-    EXPECT_EQ(inclined.inclination.edges, (std::vector<double>{0, 30, 60, 90, 120, 150, 180}));
-    EXPECT_FALSE(general.inclination.Used());
+    // The default bins the structures' inclination in steps of 30°; the policy without
+    // those bins is the default otherwise.
+    EXPECT_EQ(general.inclination.edges, (std::vector<double>{0, 30, 60, 90, 120, 150, 180}));
+    const InstancingPolicy upright = LoadPolicyFile(PolicyPath("no_inclination.txtpb"));
+    EXPECT_EQ(upright.leafCount.edges, steps);
+    EXPECT_FALSE(upright.inclination.Used());
+    EXPECT_EQ(DefaultPolicy().inclination.edges, general.inclination.edges);
 }
 
 TEST(PolicyFile, UnknownFieldNamesFileLineAndColumn) {
@@ -376,6 +378,7 @@ leaf_count {
   edges: 11 edges: 16 edges: 23 edges: 32
   edges: [45, 64, 91, 128, 181, 256, 362, 512, 724, 1000, 1e4]
 }
+inclination { edges: [0, 30.0, 60, 90, 120, 150, 1.8e2] }
 fixed { type: NODE_TYPE_AXIS leaf_count_above: 10000 }
 fixed { type: NODE_TYPE_PLANT leaf_count_above: 10000 }
 transmittance { direction_count: 130 kind: FUNCTION_KIND_MONO }
