@@ -165,9 +165,10 @@ Refiner::Verdict Refiner::JudgeSource(std::uint32_t r, std::uint32_t s) const {
     // what their leaves do in the flattened scene, 2.9 % now
     // (Instanced.PlantsSolvedWholeInEachOthersCrownsTakeTheirShade).
     if (hierarchy_[r].closed >= 0 && error > threshold) {
-        const int n = visibility_.SourceRays(s);
-        const double p = (v * n + 1.0) / (n + 2.0);  // Laplace's rule, as VisibilitySpread
-        const double rounds = unoccluded * unoccluded * p * (1.0 - p) / (n * threshold * threshold);
+        const int rays = visibility_.SourceRays(s);
+        const double p = (v * rays + 1.0) / (rays + 2.0);  // Laplace's rule, as VisibilitySpread
+        const double rounds =
+            unoccluded * unoccluded * p * (1.0 - p) / (rays * threshold * threshold);
         value = visibility_.FromSource(
             r, s, source, RaySet::kValuing, verdict.rays,
             static_cast<int>(std::clamp(std::ceil(rounds), 1.0, double{kClosedRounds})));
