@@ -141,6 +141,45 @@ TEST(RayScene, TracesRaysOfOneDirectionTogetherAsOneByOne) {
     EXPECT_LT(blocked, static_cast<int>(starts.size()));
 }
 
+TEST(RayScene, FindsTheFirstHitsOfRaysTracedTogetherAsOneByOne) {
+    // Plates 1 µm to 0.3 m apart, shifted sideways: rays leave every triangle (and points
+    // off the surfaces) in directions all round, some meeting a plate, some escaping.
+    std::vector<std::shared_ptr<const Mesh>> plates;
+    for (int k = 0; k < 6; ++k) {
+        const double x = 0.3 * k, z = k == 1 ? 1e-6 : 0.3 * k;
+        plates.push_back(Quad({x, 0, z}, {x + 1, 0, z}, {x + 1, 1, z}, {x, 1, z}));
+    }
+    const FlatScene flat = Plates(plates);
+    const RayScene rays(flat, std::nullopt);
+    Random random(7);
+    std::vector<RayStart> starts;
+    std::vector<glm::dvec3> directions;
+    for (std::uint32_t t = 0; t < flat.triangles.size(); ++t) {
+        const Triangle& tri = flat.triangles[t];
+        for (int k = 0; k < 8; ++k) {
+            const glm::dvec3 w = UniformTriangle(random.Uniform(), random.Uniform());
+            starts.push_back({w.x * tri.a + w.y * tri.b + w.z * tri.c, t});
+            directions.push_back(UniformSphere(random.Uniform(), random.Uniform()));
+        }
+        starts.push_back({(tri.a + tri.b + tri.c) / 3.0 + glm::dvec3(0, 0, 0.05)});
+        directions.push_back(glm::dvec3(0, 0, -1));
+    }
+    std::vector<RayHit> together;
+    rays.Trace(starts, directions, together);
+    ASSERT_EQ(together.size(), starts.size());
+    int hits = 0;
+    for (std::size_t i = 0; i < starts.size(); ++i) {
+        const RayHit one = rays.Trace(starts[i], directions[i]);
+        EXPECT_EQ(together[i].fate, one.fate) << "ray " << i;
+        EXPECT_EQ(together[i].triangle, one.triangle) << "ray " << i;
+        EXPECT_EQ(together[i].distance, one.distance) << "ray " << i;
+        EXPECT_EQ(together[i].next.origin, one.next.origin) << "ray " << i;
+        hits += one.fate == RayFate::kHit;
+    }
+    EXPECT_GT(hits, 0);
+    EXPECT_LT(hits, static_cast<int>(starts.size()));
+}
+
 TEST(RayScene, WrapsAroundAPeriodicTile) {
     // A plate overhanging the tile [0, 1]² on the +x side, at z = 1.
     const auto plate = Quad({0.8, 0.4, 1}, {1.2, 0.4, 1}, {1.2, 0.6, 1}, {0.8, 0.6, 1});

@@ -1,5 +1,7 @@
 #include "solver/instancing/instance_tree.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <array>
 #include <limits>
@@ -73,9 +75,11 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
                 walk.push_back({c, instanceFromNode * glm::dmat4(scene.nodes[c].parentFromLocal)});
         }
     };
-    std::array<double, AreaGrid::kCount> cells;
-    for (std::uint32_t p = 1; p < parts_.size(); ++p) {
+    // Each part walks its own subtree, the parts at once: every level of them walks the
+    // whole scene again.
+    tbb::parallel_for(std::size_t{1}, parts_.size(), [&](std::size_t p) {
         Part& part = parts_[p];
+        std::array<double, AreaGrid::kCount> cells;
         glm::dvec3 lo(std::numeric_limits<double>::max()), hi = -lo;
         walkOrgans(part, [&](const Mesh& mesh, const glm::dmat4& instanceFromNode) {
             for (const glm::dvec3& v : mesh.positions) {
@@ -103,12 +107,12 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
                 part.leafAreaM2 += area;
             }
         });
-        if (!(part.leafAreaM2 > 0.0)) continue;
+        if (!(part.leafAreaM2 > 0.0)) return;
         auto grid = std::make_shared<AreaGrid>();
         for (int c = 0; c < AreaGrid::kCount; ++c)
             grid->share[c] = static_cast<float>(cells[c] / part.leafAreaM2);
         part.area = std::move(grid);
-    }
+    });
 }
 
 }  // namespace leaflux

@@ -261,7 +261,7 @@ Sight LinkVisibility::Between(std::uint32_t r, std::uint32_t s, RaySet set, std:
     return Seen(tally, 0.0);
 }
 
-LinkVisibility::OrganLight LinkVisibility::ClosedOrganLight(std::int32_t c, const glm::dvec3& x,
+LinkVisibility::OrganPoint LinkVisibility::ClosedOrganPoint(std::int32_t c, const glm::dvec3& x,
                                                             const glm::dvec3& toward) const {
     const ShadowView& shadows = occlusion_.Shadows();
     const ClosedNode& node = hierarchy_.Closed()[c];
@@ -289,16 +289,23 @@ LinkVisibility::OrganLight LinkVisibility::ClosedOrganLight(std::int32_t c, cons
         k -= range[1] - range[0];
     }
     const std::array<glm::dvec3, 3> corners = shadows.rays->Corners(t);
-    OrganLight organ;
-    organ.weight = 0.5 * std::abs(glm::dot(
+    OrganPoint point;
+    point.weight = 0.5 * std::abs(glm::dot(
                              glm::cross(corners[1] - corners[0], corners[2] - corners[0]), toward));
-    if (!(organ.weight > 0.0)) return organ;
+    if (!(point.weight > 0.0)) return {};
     const glm::dvec3 w = UniformTriangle(f.y, f.z);
-    const RayStart start{w.x * corners[0] + w.y * corners[1] + w.z * corners[2], t};
+    point.start = {w.x * corners[0] + w.y * corners[1] + w.z * corners[2], t};
+    return point;
+}
+
+LinkVisibility::OrganLight LinkVisibility::ClosedOrganLight(std::int32_t c, const RayHit& hit,
+                                                            const glm::dvec3& toward) const {
+    const ShadowView& shadows = occlusion_.Shadows();
+    const RayScene::TriangleRanges& own = *hierarchy_.Closed()[c].shadowTriangles;
     // The first triangle it meets: none, it is lit; one of its own organs, it is not, nor
     // past them; another, it is not, and past its own organs only if none lies further on
     // (in its box: past its side, the ray has passed them).
-    const RayHit hit = shadows.rays->Trace(start, toward);
+    OrganLight organ;
     organ.lit = hit.fate != RayFate::kHit;
     organ.ownLit =
         organ.lit ||
@@ -360,17 +367,26 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
             std::int32_t closed;
         };
         thread_local std::vector<ClosedRay> closedRays;
-        closedRays.clear();
+        // The rays from points of closed instances' organs, and their weights.
+        thread_local std::vector<RayStart> organStarts;
+        thread_local std::vector<glm::dvec3> organDirections;
+        thread_local std::vector<double> organWeights;
+        thread_local std::vector<std::int32_t> organClosed;
+        thread_local std::vector<RayHit> organHits;
+        closedRays.clear(), organStarts.clear(), organDirections.clear(), organWeights.clear(),
+            organClosed.clear();
         std::size_t batch = 0;  // the rays traced together, moved to the front
         for (std::size_t i = 0; i < starts.size(); ++i) {
             total += weights[i];
             if (closed[i] >= 0) {
                 closedWeight += weights[i];
-                const OrganLight organ =
-                    ClosedOrganLight(closed[i], starts[i].origin, directions[i]);
-                if (organ.ownLit) {
-                    organs.total += weights[i] * organ.weight;
-                    if (organ.lit) organs.visible += weights[i] * organ.weight;
+                const OrganPoint organ =
+                    ClosedOrganPoint(closed[i], starts[i].origin, directions[i]);
+                if (organ.weight > 0.0) {
+                    organStarts.push_back(organ.start);
+                    organDirections.push_back(directions[i]);
+                    organWeights.push_back(weights[i] * organ.weight);
+                    organClosed.push_back(closed[i]);
                 }
                 closedRays.push_back({starts[i].origin, directions[i], closed[i]});
                 continue;
@@ -381,6 +397,14 @@ double LinkVisibility::FromSource(std::uint32_t r, std::uint32_t source,
             weights[batch++] = weights[i];
         }
         starts.resize(batch), directions.resize(batch), weights.resize(batch);
+        shadows.rays->Trace(organStarts, organDirections, organHits);
+        for (std::size_t k = 0; k < organStarts.size(); ++k) {
+            const OrganLight organ =
+                ClosedOrganLight(organClosed[k], organHits[k], organDirections[k]);
+            if (!organ.ownLit) continue;
+            organs.total += organWeights[k];
+            if (organ.lit) organs.visible += organWeights[k];
+        }
         shadows.rays->Occluded(starts, directions, occluded);
         for (std::size_t i = 0; i < batch; ++i) {
             if (!occluded[i]) visible += weights[i];

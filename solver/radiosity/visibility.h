@@ -146,14 +146,20 @@ class LinkVisibility {
     // The direct light on a point of closed instance c's organs from a light (unit
     // `toward`), in the whole scene's shadow engine, drawn from point x of its box
     // (Hierarchy::SampleClosed's three coordinates): one of its organs' triangles taken
-    // evenly, a point of it, weighted by the triangle's area across the light; whether the
-    // point is lit past the instance's own organs, and past everything of the scene.
-    struct OrganLight {
+    // evenly, a point of it, weighted by the triangle's area across the light
+    // (ClosedOrganPoint, weight 0: none); then, from the first triangle the ray from it
+    // meets, whether the point is lit past the instance's own organs, and past everything
+    // of the scene (ClosedOrganLight). The rays of a link are traced together between.
+    struct OrganPoint {
+        RayStart start;
         double weight = 0.0;
+    };
+    struct OrganLight {
         bool ownLit = false, lit = false;
     };
-    OrganLight ClosedOrganLight(std::int32_t c, const glm::dvec3& x,
+    OrganPoint ClosedOrganPoint(std::int32_t c, const glm::dvec3& x,
                                 const glm::dvec3& toward) const;
+    OrganLight ClosedOrganLight(std::int32_t c, const RayHit& hit, const glm::dvec3& toward) const;
     Sight BetweenPatches(std::uint32_t r, std::uint32_t s, RaySet set, std::int64_t& rays,
                          LinkRays& tally, int upTo) const;
     // What passes along a link's ray from p, `length` long, towards an end inside closed

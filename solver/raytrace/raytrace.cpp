@@ -204,13 +204,16 @@ RayScene::~RayScene() {
     if (mesh_) rtcReleaseScene(mesh_);
 }
 
-RayHit RayScene::TraceOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const {
-    StartContext context = MakeContext(start.copy);
+namespace {
+RTCRayHit EmbreeRayHit(const RayStart& start, const glm::dvec3& direction, double tFar) {
     RTCRayHit rayHit;
     rayHit.ray = EmbreeRay(start, direction, tFar);
     rayHit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rayHit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(top_, &context.context, &rayHit);
+    return rayHit;
+}
+
+RayHit HitOf(const RTCRayHit& rayHit, const RayStart& start, const glm::dvec3& direction) {
     RayHit result;
     if (rayHit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return result;
     result.fate = RayFate::kHit;
@@ -221,6 +224,36 @@ RayHit RayScene::TraceOnce(const RayStart& start, const glm::dvec3& direction, d
     const unsigned instance = rayHit.hit.instID[0];
     result.next.copy = instance == RTC_INVALID_GEOMETRY_ID ? 0 : static_cast<int>(instance);
     return result;
+}
+}  // namespace
+
+RayHit RayScene::TraceOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const {
+    StartContext context = MakeContext(start.copy);
+    RTCRayHit rayHit = EmbreeRayHit(start, direction, tFar);
+    rtcIntersect1(top_, &context.context, &rayHit);
+    return HitOf(rayHit, start, direction);
+}
+
+void RayScene::Trace(const std::vector<RayStart>& starts, const std::vector<glm::dvec3>& directions,
+                     std::vector<RayHit>& hits) const {
+    hits.resize(starts.size());
+    if (periodic_) {
+        for (std::size_t i = 0; i < starts.size(); ++i) hits[i] = Trace(starts[i], directions[i]);
+        return;
+    }
+    thread_local std::vector<RTCRayHit> rayHits;
+    rayHits.clear();
+    for (std::size_t i = 0; i < starts.size(); ++i) {
+        rayHits.push_back(
+            EmbreeRayHit(starts[i], directions[i], std::numeric_limits<double>::infinity()));
+    }
+    StartContext context = MakeContext(0);
+    rtcIntersect1M(top_, &context.context, rayHits.data(), static_cast<unsigned>(rayHits.size()),
+                   sizeof(RTCRayHit));
+    for (std::size_t i = 0; i < starts.size(); ++i) {
+        hits[i] = HitOf(rayHits[i], starts[i], directions[i]);
+        if (hits[i].fate != RayFate::kHit) hits[i].fate = Escape(directions[i]);
+    }
 }
 
 bool RayScene::OccludedOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const {

@@ -90,6 +90,9 @@ class RayScene {
     // The first surface along the ray. In a periodic scene a ray that leaves the tile
     // sideways re-enters on the other side; it escapes up or down past the scene's bounds.
     RayHit Trace(const RayStart& start, const glm::dvec3& direction) const;
+    // Trace for many rays, traced together: hits[i] is ray i's.
+    void Trace(const std::vector<RayStart>& starts, const std::vector<glm::dvec3>& directions,
+               std::vector<RayHit>& hits) const;
 
     // Whether anything lies along the ray within maxDistance (infinity: to the sky).
     bool Occluded(const RayStart& start, const glm::dvec3& direction,
