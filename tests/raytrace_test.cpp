@@ -110,15 +110,20 @@ TEST(RayScene, OccludedAmongMeetsOnlyTheTrianglesListed) {
     }
 }
 
-TEST(RayScene, TracesRaysOfOneDirectionTogetherAsOneByOne) {
-    // Plates 1 µm to 0.3 m apart, shifted sideways: rays leave every triangle (and points
-    // off the surfaces) towards one sun, some blocked, some not.
+// Six plates 1 µm to 0.3 m apart, shifted sideways.
+FlatScene SteppedPlates() {
     std::vector<std::shared_ptr<const Mesh>> plates;
     for (int k = 0; k < 6; ++k) {
         const double x = 0.3 * k, z = k == 1 ? 1e-6 : 0.3 * k;
         plates.push_back(Quad({x, 0, z}, {x + 1, 0, z}, {x + 1, 1, z}, {x, 1, z}));
     }
-    const FlatScene flat = Plates(plates);
+    return Plates(plates);
+}
+
+TEST(RayScene, TracesRaysOfOneDirectionTogetherAsOneByOne) {
+    // Rays leave every triangle (and points off the surfaces) towards one sun, some
+    // blocked, some not.
+    const FlatScene flat = SteppedPlates();
     const RayScene rays(flat, std::nullopt);
     const glm::dvec3 sun = glm::normalize(glm::dvec3(0.4, 0.1, 1.0));
     std::vector<RayStart> starts;
@@ -142,14 +147,9 @@ TEST(RayScene, TracesRaysOfOneDirectionTogetherAsOneByOne) {
 }
 
 TEST(RayScene, FindsTheFirstHitsOfRaysTracedTogetherAsOneByOne) {
-    // Plates 1 µm to 0.3 m apart, shifted sideways: rays leave every triangle (and points
-    // off the surfaces) in directions all round, some meeting a plate, some escaping.
-    std::vector<std::shared_ptr<const Mesh>> plates;
-    for (int k = 0; k < 6; ++k) {
-        const double x = 0.3 * k, z = k == 1 ? 1e-6 : 0.3 * k;
-        plates.push_back(Quad({x, 0, z}, {x + 1, 0, z}, {x + 1, 1, z}, {x, 1, z}));
-    }
-    const FlatScene flat = Plates(plates);
+    // Rays leave every triangle (and points above the plates) in directions all round,
+    // some meeting a plate, some escaping.
+    const FlatScene flat = SteppedPlates();
     const RayScene rays(flat, std::nullopt);
     Random random(7);
     std::vector<RayStart> starts;
