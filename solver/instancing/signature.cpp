@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "solver/scene/topology.h"
+#include "solver/scene/world_frames.h"
 #include "solver/util/check.h"
 #include "solver/util/error.h"
 
@@ -16,10 +17,9 @@ namespace {
 
 bool IsLeafOrgan(const Node& node) { return node.type == NodeType::kLeaf && node.organ; }
 
-// Per node, by position in scene.nodes: the leaf organs in its subtree, and, when asked,
-// the angle (degrees) between its frame's z and the world's up. A breadth-first order from
-// the roots takes each node's world frame from its parent's; sums from the last node back
-// to the roots take the leaves.
+// Per node, by position in scene.nodes: the leaf organs in its subtree (sums from the last
+// node of a breadth-first order back to the roots), and, when asked, the angle (degrees)
+// between its frame's z and the world's up (ForEachWorldFrame).
 struct NodeFacts {
     std::vector<std::int64_t> leaves;
     std::vector<double> inclination;
@@ -36,17 +36,12 @@ NodeFacts FactsOf(const Scene& scene, bool inclination) {
     LEAFLUX_CHECK(order.size() == n);  // a validated scene is a forest
     NodeFacts facts{std::vector<std::int64_t>(n, 0), std::vector<double>(inclination ? n : 0, 0.0)};
     if (inclination) {
-        std::vector<glm::dmat3> world(n);  // 72 bytes a node, while classifying
-        for (const std::uint32_t i : order) {
-            const glm::dmat3 local(glm::dmat4(scene.nodes[i].parentFromLocal));
-            const std::uint32_t parent = topology.Parent(i);
-            world[i] = parent == Topology::kNone ? local : world[parent] * local;
-            const double length = glm::length(world[i][2]);
-            facts.inclination[i] =
-                length > 0.0
-                    ? glm::degrees(std::acos(std::clamp(world[i][2].z / length, -1.0, 1.0)))
-                    : 0.0;
-        }
+        ForEachWorldFrame(scene, [&](const Node& node, const glm::dmat4& worldFromLocal) {
+            const glm::dvec3 z(worldFromLocal[2]);
+            const double length = glm::length(z);
+            facts.inclination[&node - scene.nodes.data()] =
+                length > 0.0 ? glm::degrees(std::acos(std::clamp(z.z / length, -1.0, 1.0))) : 0.0;
+        });
     }
     for (auto k = order.rbegin(); k != order.rend(); ++k) {
         if (IsLeafOrgan(scene.nodes[*k])) ++facts.leaves[*k];

@@ -96,6 +96,27 @@ namespace {
 RayFate Escape(const glm::dvec3& direction) {
     return direction.z > 0.0 ? RayFate::kEscapedUp : RayFate::kEscapedDown;
 }
+
+RTCRayHit EmbreeRayHit(const RayStart& start, const glm::dvec3& direction, double tFar) {
+    RTCRayHit rayHit;
+    rayHit.ray = EmbreeRay(start, direction, tFar);
+    rayHit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rayHit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    return rayHit;
+}
+
+RayHit HitOf(const RTCRayHit& rayHit, const RayStart& start, const glm::dvec3& direction) {
+    RayHit result;
+    if (rayHit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return result;
+    result.fate = RayFate::kHit;
+    result.triangle = rayHit.hit.primID;
+    result.distance = rayHit.ray.tfar;
+    result.next.origin = start.origin + direction * result.distance;
+    result.next.triangle = rayHit.hit.primID;
+    const unsigned instance = rayHit.hit.instID[0];
+    result.next.copy = instance == RTC_INVALID_GEOMETRY_ID ? 0 : static_cast<int>(instance);
+    return result;
+}
 }  // namespace
 
 void SetFlushToZero() {
@@ -203,29 +224,6 @@ RayScene::~RayScene() {
     if (top_) rtcReleaseScene(top_);
     if (mesh_) rtcReleaseScene(mesh_);
 }
-
-namespace {
-RTCRayHit EmbreeRayHit(const RayStart& start, const glm::dvec3& direction, double tFar) {
-    RTCRayHit rayHit;
-    rayHit.ray = EmbreeRay(start, direction, tFar);
-    rayHit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rayHit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    return rayHit;
-}
-
-RayHit HitOf(const RTCRayHit& rayHit, const RayStart& start, const glm::dvec3& direction) {
-    RayHit result;
-    if (rayHit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return result;
-    result.fate = RayFate::kHit;
-    result.triangle = rayHit.hit.primID;
-    result.distance = rayHit.ray.tfar;
-    result.next.origin = start.origin + direction * result.distance;
-    result.next.triangle = rayHit.hit.primID;
-    const unsigned instance = rayHit.hit.instID[0];
-    result.next.copy = instance == RTC_INVALID_GEOMETRY_ID ? 0 : static_cast<int>(instance);
-    return result;
-}
-}  // namespace
 
 RayHit RayScene::TraceOnce(const RayStart& start, const glm::dvec3& direction, double tFar) const {
     StartContext context = MakeContext(start.copy);
