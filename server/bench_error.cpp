@@ -248,6 +248,12 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
             pushed.setting = run.setting + " output=axis pushed-down";
             pushed.settings.instanced.pushDown = true;
             runs.push_back(pushed);
+            if (options.instancedMerge > 0) {
+                Run merged = run;
+                merged.setting += " merge-triangles=" + std::to_string(options.instancedMerge);
+                merged.settings.instanced.mergeTriangles = options.instancedMerge;
+                runs.push_back(merged);
+            }
             for (int depth : options.instancedDepths) {
                 Run shallow = run;
                 shallow.setting += " depth=" + std::to_string(depth) + " per-structure";

@@ -66,6 +66,14 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
                    "solved whole get light handed down from the structure's (straight light "
                    "from its box's sides through its transmittance, what it absorbs beyond that "
                    "evenly), in --out: approximate, for a little more time");
+    solve
+        .add_option("--merge-triangles", command.mergeTriangles,
+                    "instanced: an opened instance of at most this many organ triangles in all "
+                    "is solved as one local problem with the smaller instances it holds, rather "
+                    "than each of them closed and opened in turn (not with --output-level; 0: "
+                    "never)")
+        ->capture_default_str()
+        ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
     solve.add_option("--problems", command.problems,
                      "instanced: CSV of every local problem solved: depth, triangles, closed "
                      "instances, elements, links, seconds");
@@ -90,6 +98,7 @@ Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene*
     options.hrc.directionalInstances = !command.singleValue;
     options.holdOutside = !command.perBin;
     options.maxDepth = command.maxDepth;
+    options.mergeTriangles = command.mergeTriangles;
     options.pushDown = command.pushDown;
     options.inView = command.inView;
     if (!command.outputLevel.empty()) {
@@ -100,8 +109,11 @@ Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene*
     InstancedSolution solved = SolveInstanced(scene, flat, shadows, policy, database, options);
     const InstancedStats& stats = solved.stats;
     std::printf("instances by depth (opened):");
-    for (std::size_t d = 1; d < stats.depths.size(); ++d)
-        std::printf(" %zu: %d (%d)", d, stats.depths[d].instances, stats.depths[d].opened);
+    for (std::size_t d = 1; d < stats.depths.size(); ++d) {
+        std::printf(" %zu: %d (%d", d, stats.depths[d].instances, stats.depths[d].opened);
+        if (stats.depths[d].merged > 0) std::printf(", %d merged", stats.depths[d].merged);
+        std::printf(")");
+    }
     int whole = 0;
     for (const InstancedStats::Depth& d : stats.depths) whole += d.whole;
     if (whole > 0) std::printf("; %d solved whole", whole);

@@ -20,6 +20,7 @@ struct InstancedCommand {
     bool perBin = false;   // InstancedOptions::holdOutside off
     std::string problems;  // CSV of the local problems solved
     int maxDepth = 0;
+    std::int64_t mergeTriangles = InstancedOptions{}.mergeTriangles;
     bool pushDown = false;    // InstancedOptions::pushDown
     std::string outputLevel;  // "", "plant", "axis" or "phytomer"
     // Set by leaflux render --open-in-view (InstancedOptions::inView).

@@ -124,6 +124,11 @@ InstancedRun InstancedRunFromProto(const v1::InstancedSettings& in, const std::s
                          "solved whole");
     }
     run.options.pushDown = in.push_down();
+    if (in.merge_triangles() < 0) {
+        throw InputError(ErrorCode::kInvalidArgument, std::string(kField) + ".merge_triangles",
+                         "must be 0 or more");
+    }
+    run.options.mergeTriangles = in.merge_triangles();
     switch (in.shadows()) {
         case v1::INSTANCED_SHADOWS_UNSPECIFIED:
         case v1::INSTANCED_SHADOWS_GEOMETRY:

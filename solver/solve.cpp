@@ -47,6 +47,7 @@ Solution Solve(const PreparedScene& prepared, const SolverSettings& settings) {
             options.outputLevel = instanced.outputLevel;
             options.pushDown = instanced.pushDown;
             options.holdOutside = instanced.holdOutside;
+            options.mergeTriangles = instanced.mergeTriangles;
             InstancedSolution solved =
                 SolveInstanced(prepared.Source(), prepared.Flat(),
                                instanced.shadowsByGeometry ? &prepared.Rays() : nullptr,

@@ -26,6 +26,7 @@ struct InstancedSettings {
     std::optional<NodeType> outputLevel;  // InstancedOptions::outputLevel
     bool pushDown = false;                // InstancedOptions::pushDown
     bool holdOutside = true;              // InstancedOptions::holdOutside
+    std::int64_t mergeTriangles = 0;      // InstancedOptions::mergeTriangles
     // Filled by the solve when not null: its instances, local problems and originals.
     InstancedStats* stats = nullptr;
 };

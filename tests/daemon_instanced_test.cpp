@@ -25,14 +25,14 @@ namespace {
 
 constexpr const char* kSpecies = "test-tree";
 
-// Three small trees in a row under a sun and a sky, two bands.
-Scene Trees(int trees = 3) {
+// Small trees in a row (three of 40 leaves by default) under a sun and a sky, two bands.
+Scene Trees(int trees = 3, int leaves = 40) {
     Scene scene;
     scene.bands = {{"PAR"}, {"NIR"}};
     scene.optics = {{"leaf", {{0.08, 0.06, 0.05, 0.05}, {0.45, 0.4, 0.45, 0.45}}},
                     {"stem", {{0.1, 0.1, 0.0, 0.0}, {0.3, 0.3, 0.0, 0.0}}}};
     TreeParameters tree;
-    tree.leafCount = 40;
+    tree.leafCount = leaves;
     NodeId next = 1;
     for (int t = 0; t < trees; ++t) {
         tree.seed = 1 + t;
@@ -232,6 +232,26 @@ TEST(DaemonInstanced, APerBinSessionGetsTheLightOfAPerBinSolve) {
     EXPECT_GT(largest, 1e-3);  // the field changed the solve
 }
 
+// `merge_triangles`: the session's plants solved each as one problem with the axes they
+// hold, as `leaflux solve --merge-triangles` solves them.
+TEST(DaemonInstanced, AMergingSessionGetsTheLightOfAMergedSolve) {
+    Daemon daemon;
+    const v1::Scene scene = InlineProto(Trees(2, 150));  // axes of more than 10 leaves
+    v1::SolverSettings settings = Instanced();
+    settings.mutable_instanced()->set_merge_triangles(1 << 20);
+    const v1::CycleResult result = RunCycle(daemon, Open(daemon, scene, settings), 1);
+    InstancedOptions merged = AloneOptions();
+    merged.mergeTriangles = 1 << 20;
+    ExpectSameLight(result, SolvedAlone(scene, daemon.PhaseFunctions(), merged), 1);
+    const auto opened = SolvedAlone(scene, daemon.PhaseFunctions());
+    double largest = 0.0;
+    for (const v1::OrganLight& organ : result.organs()) {
+        largest = std::max(largest, std::abs(organ.bands(0).irradiance_lower_wm2() -
+                                             opened.at(organ.node()).irradianceLowerWm2));
+    }
+    EXPECT_GT(largest, 1e-3);  // the field changed the solve
+}
+
 // `push_down` with `output_level`: every organ of the plants solved whole is in the reply,
 // with the light `leaflux solve --output-level plant --push-down` hands down to it.
 TEST(DaemonInstanced, APushDownSessionGetsTheLightHandedDownToEveryOrgan) {
@@ -368,6 +388,9 @@ TEST(DaemonInstanced, BadInstancedSettingsAreRefusedNamingTheField) {
     v1::SolverSettings pushDown = Instanced();
     pushDown.mutable_instanced()->set_push_down(true);  // nothing solved whole to hand down
     refused(pushDown, "settings.instanced.push_down");
+    v1::SolverSettings merge = Instanced();
+    merge.mutable_instanced()->set_merge_triangles(-1);
+    refused(merge, "settings.instanced.merge_triangles");
     v1::SolverSettings inlinePolicy = Instanced();
     inlinePolicy.mutable_instanced()->mutable_inline_policy()->set_species("x");
     refused(inlinePolicy, "settings.instanced.inline_policy.phase");

@@ -367,6 +367,80 @@ TEST(Instanced, LightPerAxisOpensAPlantWhoseAxesAreNoInstances) {
     EXPECT_GT(axes, 2);
 }
 
+// Merging (InstancedOptions::mergeTriangles): a plant of no more triangles than the bound
+// is solved as one problem with the axes it holds, as though they were no instances — to
+// the last digit — and their functions are never computed. Without the bound they are
+// opened one by one, and the light differs.
+TEST(Instanced, MergedAxesAreSolvedAsAxesThatAreNoInstances) {
+    const Scene scene = Copies(2, 60);
+    const PreparedScene prepared(scene);
+    InstancingPolicy axes = Plants();
+    axes.instanceTypes = {NodeType::kPlant, NodeType::kAxis};
+    axes.byType = true;
+    const auto solve = [&](const InstancingPolicy& policy, std::int64_t merge) {
+        PhaseDatabase database({});
+        InstancedOptions options;
+        options.hrc.epsilon = 1e-4;
+        options.mergeTriangles = merge;
+        return SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), policy, database, options);
+    };
+    const InstancedSolution plantsAlone = solve(Plants(), 0);
+    const InstancedSolution merged = solve(axes, 1 << 30);
+    const InstancedSolution opened = solve(axes, 0);
+    ASSERT_GE(merged.stats.depths.size(), 3u);
+    EXPECT_EQ(merged.stats.depths[1].opened, 2);
+    EXPECT_EQ(merged.stats.depths[1].merged, 0);
+    for (std::size_t d = 2; d < merged.stats.depths.size(); ++d) {
+        EXPECT_EQ(merged.stats.depths[d].merged, merged.stats.depths[d].instances) << d;
+        EXPECT_EQ(merged.stats.depths[d].opened, 0) << d;
+    }
+    EXPECT_EQ(merged.stats.originalsComputed, plantsAlone.stats.originalsComputed);
+    EXPECT_GT(opened.stats.originalsComputed, merged.stats.originalsComputed);
+    EXPECT_EQ(opened.stats.depths[2].opened, opened.stats.depths[2].instances);
+    testing::ExpectIdenticalLight(merged.solution, plantsAlone.solution);
+    double apart = 0.0;
+    for (std::size_t r = 0; r < opened.solution.light.size(); ++r)
+        apart += std::abs(opened.solution.light[r][0].irradianceUpperWm2 -
+                          merged.solution.light[r][0].irradianceUpperWm2);
+    EXPECT_GT(apart, 0.0);
+}
+
+// Merging takes each instance whole or not at all: every scene node lies in one part that
+// is not merged, the merged parts hold none, and a plant over the bound keeps its axes.
+TEST(Instanced, MergingLeavesEveryNodeInOnePart) {
+    const Scene scene = Copies(2, 60);
+    InstancingPolicy axes = Plants();
+    axes.instanceTypes = {NodeType::kPlant, NodeType::kAxis};
+    axes.byType = true;
+    const SceneSignatures signatures = ComputeSignatures(scene, axes);
+    InstanceTree tree(scene, signatures);
+    const std::size_t parts = tree.Parts().size();
+    const std::int64_t plantTriangles = [&] {
+        std::int64_t all = 0;
+        for (const InstanceTree::Part& part : tree.Parts()) all += part.triangles;
+        return all / 2;  // two copies, nothing at the top
+    }();
+    tree.Merge(plantTriangles - 1, [](std::uint32_t) { return true; });
+    std::vector<int> owners(scene.nodes.size(), 0);
+    const auto count = [&](const InstanceTree& t) {
+        std::fill(owners.begin(), owners.end(), 0);
+        for (const InstanceTree::Part& part : t.Parts()) {
+            if (part.merged) {
+                EXPECT_TRUE(part.nodes.empty() && part.instances.empty());
+                continue;
+            }
+            for (std::size_t i : part.nodes) ++owners[i];
+        }
+        for (std::size_t i = 0; i < owners.size(); ++i) EXPECT_EQ(owners[i], 1) << i;
+    };
+    count(tree);
+    EXPECT_FALSE(tree[1].instances.empty());  // over the bound: its axes stay
+    tree.Merge(plantTriangles, [](std::uint32_t) { return true; });
+    count(tree);
+    ASSERT_EQ(tree.Parts().size(), parts);
+    for (std::uint32_t p = 1; p < parts; ++p) EXPECT_EQ(tree[p].merged, tree[p].depth > 1) << p;
+}
+
 // An instance's area grid holds its organs' whole area, in the cells where they lie: the
 // grid's shares add up to 1, and their mean cell centre is the organs' area centroid
 // within half a cell's size (each share sits at its cell's centre).

@@ -115,4 +115,35 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
     });
 }
 
+void InstanceTree::Merge(std::int64_t triangles, const std::function<bool(std::uint32_t)>& opens) {
+    if (triangles <= 0) return;
+    // A part's instances come after it: its whole count from the last part up, and whether
+    // every instance in it opens.
+    std::vector<std::int64_t> whole(parts_.size());
+    std::vector<std::uint8_t> allOpen(parts_.size(), 1);
+    for (std::size_t p = parts_.size(); p-- > 0;) {
+        whole[p] = parts_[p].triangles;
+        for (std::uint32_t q : parts_[p].instances) {
+            whole[p] += whole[q];
+            allOpen[p] &= allOpen[q] && opens(q);
+        }
+    }
+    for (std::size_t p = 1; p < parts_.size(); ++p) {
+        Part& part = parts_[p];
+        if (part.merged || part.instances.empty() || whole[p] > triangles || !allOpen[p]) continue;
+        std::vector<std::uint32_t> inner = part.instances;
+        for (std::size_t k = 0; k < inner.size(); ++k) {
+            Part& q = parts_[inner[k]];
+            q.merged = true;
+            part.nodes.insert(part.nodes.end(), q.nodes.begin(), q.nodes.end());
+            inner.insert(inner.end(), q.instances.begin(), q.instances.end());
+            std::vector<std::size_t>().swap(q.nodes);  // held once, by the part solving them
+            std::vector<std::uint32_t>().swap(q.instances);
+        }
+        std::sort(part.nodes.begin(), part.nodes.end());  // scene order
+        part.instances.clear();
+        part.triangles = whole[p];
+    }
+}
+
 }  // namespace leaflux

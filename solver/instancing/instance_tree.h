@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <glm/glm.hpp>
 #include <memory>
 #include <string>
@@ -38,10 +39,19 @@ class InstanceTree {
         double leafAreaM2 = 0.0;
         std::shared_ptr<const AreaGrid> area;  // where in the box that area lies
         std::int64_t triangles = 0;            // of its own nodes' organs
+        // Solved as a part of the instance holding it, its nodes among that part's (Merge);
+        // `nodes` and `instances` are then empty.
+        bool merged = false;
     };
 
     // `signatures` of a validated scene (ComputeSignatures).
     InstanceTree(const Scene& scene, const SceneSignatures& signatures);
+
+    // Each instance of at most `triangles` organ triangles in all, whose smaller instances
+    // all open (`opens`), is made one part with them: their nodes join its own, and they
+    // are marked merged; the largest such instances first, so that the parts are as large
+    // as `triangles` allows. 0: none.
+    void Merge(std::int64_t triangles, const std::function<bool(std::uint32_t)>& opens);
 
     const std::vector<Part>& Parts() const { return parts_; }
     const Part& operator[](std::uint32_t part) const { return parts_[part]; }

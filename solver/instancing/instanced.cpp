@@ -9,6 +9,7 @@
 #include <map>
 #include <mutex>
 #include <numbers>
+#include <set>
 #include <tuple>
 
 #include "solver/instancing/instance_tree.h"
@@ -85,8 +86,10 @@ class InstancedSolve {
         out_.solution.unsolved.assign(receivers.receivers.size(), 0);
         if (options_.pushDown) out_.solution.pushedDown.assign(receivers.receivers.size(), 0);
         out_.stats.depths.assign(tree.Depth() + 1, InstancedStats::Depth{});
-        for (const InstanceTree::Part& part : tree.Parts())
+        for (const InstanceTree::Part& part : tree.Parts()) {
             ++out_.stats.depths[part.depth].instances;
+            out_.stats.depths[part.depth].merged += part.merged;
+        }
         out_.stats.depths[0].opened = 1;
     }
 
@@ -717,10 +720,24 @@ InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& receivers,
     // The signatures are not needed once the functions and the tree are made.
     const InstanceTree tree = [&] {
         const SceneSignatures signatures = ComputeSignatures(scene, policy);
-        OnCores(threads, [&] {
-            originals = OriginalsOf(scene, signatures, policy, options.originals, database);
-        });
-        return InstanceTree(scene, signatures);
+        InstanceTree parts(scene, signatures);
+        if (!options.outputLevel) {
+            parts.Merge(options.mergeTriangles, [&](std::uint32_t q) {
+                return options.maxDepth == 0 || parts[q].depth <= options.maxDepth;
+            });
+        }
+        // The functions of the instances some level closes.
+        std::set<std::string> closed;
+        for (const InstanceTree::Part& part : parts.Parts()) {
+            if (part.depth > 0 && !part.merged) closed.insert(part.signature);
+        }
+        if (!closed.empty()) {
+            OnCores(threads, [&] {
+                originals =
+                    OriginalsOf(scene, signatures, policy, options.originals, database, closed);
+            });
+        }
+        return parts;
     }();
     InstancedSolve solve(scene, receivers, shadows, tree, originals, options, out);
     // What the setup freed (the signatures, the scratch of the functions', the tree's and

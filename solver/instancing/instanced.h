@@ -84,13 +84,21 @@ struct InstancedOptions {
     // direction bin, the same at each of its points (the top's surfaces still held);
     // cheaper, less accurate in scattered light.
     bool holdOutside = true;
+    // An opened instance of at most this many organ triangles in all, whose smaller
+    // instances would all open, is solved as one local problem with them, their organs
+    // among its own (InstanceTree::Merge), rather than with them closed and each opened in
+    // turn: below some size a structure's own problem costs more than its leaves solved
+    // with its neighbours', and its phase function is not needed. Not with outputLevel.
+    // 0: every instance a problem of its own.
+    std::int64_t mergeTriangles = 0;
 };
 
 struct InstancedStats {
     struct Depth {
         int instances = 0;  // structures instantiated at this depth (1: the largest)
         int opened = 0;
-        int whole = 0;  // left closed and solved whole (maxDepth, outputLevel)
+        int whole = 0;   // left closed and solved whole (maxDepth, outputLevel)
+        int merged = 0;  // solved in the problem of an instance holding it (mergeTriangles)
     };
     std::vector<Depth> depths;  // [0] is the top
     // Every part solved, the top first: the local problems' sizes (Fig. 14, right).

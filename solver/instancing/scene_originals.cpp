@@ -45,10 +45,11 @@ PhaseKey KeyOf(const std::string& species, const InstancingPolicy& policy,
 
 SceneOriginals OriginalsOf(const Scene& scene, const SceneSignatures& signatures,
                            const InstancingPolicy& policy, const OriginalSettings& accuracy,
-                           PhaseDatabase& database) {
+                           PhaseDatabase& database, const std::set<std::string>& needed) {
     const OriginalSettings settings = SettingsOf(policy, accuracy);
     SceneOriginals originals;
     for (const SignatureGroup& group : signatures.groups) {
+        if (!needed.empty() && !needed.contains(group.signature)) continue;
         OriginalSettings own = settings;
         if (own.method == PhaseMethod::kRadiosity &&
             signatures.Find(group.representative)->leafCount > own.radiosityLeavesAtMost)

@@ -6,6 +6,7 @@
 
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 
 #include "solver/instancing/compute_original.h"
@@ -36,8 +37,9 @@ struct SceneOriginals {
     double reuseSeconds = 0.0;
 };
 
+// `needed`: the signatures whose originals are asked (empty: every group's).
 SceneOriginals OriginalsOf(const Scene& scene, const SceneSignatures& signatures,
                            const InstancingPolicy& policy, const OriginalSettings& accuracy,
-                           PhaseDatabase& database);
+                           PhaseDatabase& database, const std::set<std::string>& needed = {});
 
 }  // namespace leaflux
