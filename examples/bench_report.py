@@ -42,12 +42,14 @@ SCENES = {
     "tree10k": (["--leaves", "10000", "--seed", "2", "--sky-cones", "turtle46"],
                 "generated tree, 10,000 leaves, sun + 46-cone overcast sky",
                 ["--reference-samples", "8192", "--hrc-epsilon", "1e-3,1e-4,5e-5,1e-5,1e-6",
-                 "--instanced-epsilon", "1e-3,1e-4,1e-5", "--instanced-depth", "2,3"]),
+                 "--instanced-epsilon", "1e-3,1e-4,1e-5", "--instanced-depth", "2,3",
+                 "--instanced-merge", "4096"]),
     "tree119k": (["--leaves", "44500", "--seed", "2", "--sky-cones", "turtle46"],
                  "generated tree of 119k triangles (44,500 leaves and their internodes), "
                  "sun + 46-cone overcast sky",
                  ["--reference-samples", "4096", "--hrc-epsilon", "1e-3,1e-4,1e-5",
-                  "--instanced-epsilon", "1e-3,1e-4,1e-5", "--instanced-depth", "3,4"]),
+                  "--instanced-epsilon", "1e-3,1e-4,1e-5", "--instanced-depth", "3,4",
+                  "--instanced-merge", "4096"]),
     "canopy": (["--random-canopy", "--canopy-leaves", "2000", "--lai", "5", "--canopy-width", "2",
                 "--seed", "3", "--sky-cones", "turtle46"],
                "dense random canopy, 2,000 leaves, LAI 5, NIR ρ = τ = 0.45, sun + 46-cone sky",
@@ -301,7 +303,8 @@ def daemon_section(build, out, run=True):
     names = {"growing_tree": "HRC", "growing_tree_warm_start": "HRC, warm start",
              "instanced_cold": "instanced, empty database",
              "instanced_warm": "instanced, the database filled",
-             "instanced_warm_start": "instanced, the database filled, warm start"}
+             "instanced_warm_start": "instanced, the database filled, warm start",
+             "instanced_merged": "instanced, the database filled, merged below 4,096 triangles"}
     table = ["| solver | leaves | ε | median solve ms (10 cycles) | last cycle ms | sweeps (10 cycles) | "
              "phase functions computed |", "|---|---|---|---|---|---|---|"]
     keys = []

@@ -6,7 +6,8 @@
 // last cycle's light (SolverSettings.warm_start); and the same plants with the instanced
 // solver, first on a new daemon's empty phase-function database (cold: the functions
 // computed as the plant's structures appear), then as a second session on the database the
-// first filled (warm: none computed), then a third on it with the warm start.
+// first filled (warm: none computed), then a third on it with the warm start, and a fourth
+// with its small instances merged into the problems of those holding them.
 // Run: build/release/tests/leaflux_bench_daemon [out.csv, default out/bench/daemon_bench.csv]
 #include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
@@ -104,6 +105,10 @@ struct Row {
 constexpr std::pair<int, double> kGrowths[] = {{1000, 1e-4}, {1000, 3e-4},  {1000, 1e-3},
                                                {1000, 3e-3}, {10000, 1e-4}, {10000, 3e-4}};
 
+// The merge bound of the "instanced_merged" sessions: the generated trees' branches, of
+// 2,720 triangles on the 10,000-leaf plant, each solved as one problem with its twigs.
+constexpr std::int64_t kMergeTriangles = 4096;
+
 int main(int argc, char** argv) {
     using namespace leaflux;
     // Every request is logged at info level: SPDLOG_LEVEL=info shows them, debug the phases
@@ -194,6 +199,10 @@ int main(int argc, char** argv) {
         grow(fresh, "instanced_warm", leaves, settings);
         settings.set_warm_start(true);
         grow(fresh, "instanced_warm_start", leaves, settings);
+        // Its small instances solved with those that hold them (merge_triangles).
+        settings.set_warm_start(false);
+        settings.mutable_instanced()->set_merge_triangles(kMergeTriangles);
+        grow(fresh, "instanced_merged", leaves, settings);
     }
     const char* path = argc > 1 ? argv[1] : "out/bench/daemon_bench.csv";
     if (const auto folder = std::filesystem::path(path).parent_path(); !folder.empty())
