@@ -105,6 +105,31 @@ def adjust(text, endpoint, state, ports):
     return "\n".join(out) + "\n"
 
 
+def start_daemon(build, env, state):
+    """The test's leafluxd on a free port: (process, endpoint, None), or (None, None, why).
+    A port found free may be taken before leafluxd binds it (by another test's daemon): a
+    daemon that exits instead of serving is started again on another port, so that the
+    blocks never talk to a daemon that is not the test's."""
+    why = "no attempt"
+    log = os.path.join(state, "leafluxd.log")
+    for _ in range(5):
+        endpoint = f"tcp://127.0.0.1:{free_port()}"
+        daemon = subprocess.Popen([os.path.join(build, "server", "leafluxd"), "--bind", endpoint,
+                                   "--log-level", "info"], stderr=open(log, "w"), env=env)
+        deadline = time.time() + 10
+        while daemon.poll() is None and time.time() < deadline:
+            # It logs that it serves the endpoint once bound, or exits when it cannot bind.
+            if f"serving {endpoint}" in open(log, errors="replace").read() and not subprocess.run(
+                    [os.path.join(build, "server", "leaflux"), "client", "--endpoint", endpoint,
+                     "--timeout", "1", "status"], capture_output=True).returncode:
+                return daemon, endpoint, None
+            time.sleep(0.05)
+        daemon.kill()
+        daemon.wait()
+        why = f"leafluxd on {endpoint} did not answer (exit {daemon.returncode})"
+    return None, None, why
+
+
 def run_document(doc, build, source, workdir):
     """Runs `doc`'s blocks; returns (ran, skipped, failure text or None)."""
     checkout = os.path.join(workdir, "checkout")
@@ -116,13 +141,18 @@ def run_document(doc, build, source, workdir):
     home, state = os.path.join(workdir, "home"), os.path.join(workdir, "state")
     os.makedirs(home)
     os.makedirs(state)
-    endpoint = f"tcp://127.0.0.1:{free_port()}"
     env = dict(os.environ, HOME=home, XDG_DATA_HOME=os.path.join(home, "data"),
                XDG_CACHE_HOME=os.path.join(home, "cache"), LEAFLUX_BUILD="build/release",
                PYTHONPATH=os.pathsep.join([os.path.join(checkout, "python"),
                                            os.path.join(build, "proto")]),
                PATH=os.pathsep.join([os.path.join(build, "server"),
                                      os.path.join(build, "growth_stub"), os.environ["PATH"]]))
+    runnable = [b for b in blocks(doc) if not b[4] and b[1] in ("sh", "python") and b[3] is None]
+    daemon, endpoint = None, None
+    if runnable:
+        daemon, endpoint, failure = start_daemon(build, env, state)
+        if failure:
+            return [], [], failure
     script = ["set -euo pipefail",
               f"trap 'echo \"FAILED in the block at $DOCS_TEST_BLOCK\" >&2' ERR"]
     ran, skipped, ports = [], [], {}
@@ -148,14 +178,6 @@ def run_document(doc, build, source, workdir):
             script.append(adjust(text, endpoint, state, ports))
     if not ran:
         return ran, skipped, None
-    daemon = subprocess.Popen([os.path.join(build, "server", "leafluxd"), "--bind", endpoint],
-                              stderr=open(os.path.join(state, "leafluxd.log"), "w"), env=env)
-    deadline = time.time() + 10
-    while subprocess.run([os.path.join(build, "server", "leaflux"), "client", "--endpoint",
-                          endpoint, "--timeout", "1", "status"], capture_output=True).returncode:
-        if time.time() > deadline:
-            daemon.kill()
-            return ran, skipped, f"leafluxd on {endpoint} did not answer"
     open(os.path.join(state, "run.sh"), "w").write("\n".join(script) + "\n")
     # The output goes to a file, not a pipe: what a block leaves running in the background
     # (a daemon) keeps a pipe open after the script has ended.
