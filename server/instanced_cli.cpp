@@ -52,15 +52,16 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
                                   "(--structures), their leaves left out of --out; 0: every depth")
                       ->capture_default_str()
                       ->check(CLI::Range(0, 64));
-    solve
-        .add_option("--output-level", command.outputLevel,
-                    "instanced: light per structure of this type: an instance is opened only "
-                    "while it holds instances of the type (or, of another type, structures "
-                    "of the type that are not instances), the others are solved whole "
-                    "(--structures) and their leaves never built; e.g. axis for light per "
-                    "branch")
-        ->check(CLI::IsMember({"plant", "axis", "phytomer"}))
-        ->excludes(depth);
+    auto* outputLevel =
+        solve
+            .add_option("--output-level", command.outputLevel,
+                        "instanced: light per structure of this type: an instance is opened only "
+                        "while it holds instances of the type (or, of another type, structures "
+                        "of the type that are not instances), the others are solved whole "
+                        "(--structures) and their leaves never built; e.g. axis for light per "
+                        "branch")
+            ->check(CLI::IsMember({"plant", "axis", "phytomer"}))
+            ->excludes(depth);
     solve.add_flag("--push-down", command.pushDown,
                    "instanced: with --max-depth or --output-level, the leaves of the structures "
                    "solved whole get light handed down from the structure's (straight light "
@@ -70,10 +71,10 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
         .add_option("--merge-triangles", command.mergeTriangles,
                     "instanced: an opened instance of at most this many organ triangles in all "
                     "is solved as one local problem with the smaller instances it holds, rather "
-                    "than each of them closed and opened in turn (not with --output-level; 0: "
-                    "never)")
+                    "than each of them closed and opened in turn; 0: never")
         ->capture_default_str()
-        ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
+        ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40))
+        ->excludes(outputLevel);
     solve.add_option("--problems", command.problems,
                      "instanced: CSV of every local problem solved: depth, triangles, closed "
                      "instances, elements, links, seconds");

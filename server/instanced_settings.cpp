@@ -124,9 +124,10 @@ InstancedRun InstancedRunFromProto(const v1::InstancedSettings& in, const std::s
                          "solved whole");
     }
     run.options.pushDown = in.push_down();
-    if (in.merge_triangles() < 0) {
+    if (in.merge_triangles() < 0 ||
+        (in.merge_triangles() > 0 && in.output_level() != v1::NODE_TYPE_UNSPECIFIED)) {
         throw InputError(ErrorCode::kInvalidArgument, std::string(kField) + ".merge_triangles",
-                         "must be 0 or more");
+                         in.merge_triangles() < 0 ? "must be 0 or more" : "excludes output_level");
     }
     run.options.mergeTriangles = in.merge_triangles();
     switch (in.shadows()) {

@@ -391,6 +391,9 @@ TEST(DaemonInstanced, BadInstancedSettingsAreRefusedNamingTheField) {
     v1::SolverSettings merge = Instanced();
     merge.mutable_instanced()->set_merge_triangles(-1);
     refused(merge, "settings.instanced.merge_triangles");
+    merge.mutable_instanced()->set_merge_triangles(4096);
+    merge.mutable_instanced()->set_output_level(v1::NODE_TYPE_AXIS);
+    refused(merge, "settings.instanced.merge_triangles");
     v1::SolverSettings inlinePolicy = Instanced();
     inlinePolicy.mutable_instanced()->mutable_inline_policy()->set_species("x");
     refused(inlinePolicy, "settings.instanced.inline_policy.phase");
