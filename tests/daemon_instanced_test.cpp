@@ -212,6 +212,18 @@ TEST(DaemonInstanced, CyclesOfAddsRemovalsAndUpdatesGetTheLightOfASolveOfTheirSc
     EXPECT_EQ(fourthCycle.statistics().phase_db_health(), "");
 }
 
+// The largest difference between the first band's light on a cycle's organs' lower sides
+// and `light`'s.
+double LargestLowerDifference(const v1::CycleResult& result,
+                              const std::map<std::uint64_t, BandLight>& light) {
+    double largest = 0.0;
+    for (const v1::OrganLight& organ : result.organs()) {
+        largest = std::max(largest, std::abs(organ.bands(0).irradiance_lower_wm2() -
+                                             light.at(organ.node()).irradianceLowerWm2));
+    }
+    return largest;
+}
+
 // `per_bin`: an opened instance takes the light that arrived on it per direction bin, as
 // `leaflux solve --per-bin` does; not what the default's held level gives.
 TEST(DaemonInstanced, APerBinSessionGetsTheLightOfAPerBinSolve) {
@@ -224,12 +236,7 @@ TEST(DaemonInstanced, APerBinSessionGetsTheLightOfAPerBinSolve) {
     perBin.holdOutside = false;
     ExpectSameLight(result, SolvedAlone(scene, daemon.PhaseFunctions(), perBin), 1);
     const auto held = SolvedAlone(scene, daemon.PhaseFunctions());
-    double largest = 0.0;
-    for (const v1::OrganLight& organ : result.organs()) {
-        largest = std::max(largest, std::abs(organ.bands(0).irradiance_lower_wm2() -
-                                             held.at(organ.node()).irradianceLowerWm2));
-    }
-    EXPECT_GT(largest, 1e-3);  // the field changed the solve
+    EXPECT_GT(LargestLowerDifference(result, held), 1e-3);  // the field changed the solve
 }
 
 // `merge_triangles`: the session's plants solved each as one problem with the axes they
@@ -244,12 +251,7 @@ TEST(DaemonInstanced, AMergingSessionGetsTheLightOfAMergedSolve) {
     merged.mergeTriangles = 1 << 20;
     ExpectSameLight(result, SolvedAlone(scene, daemon.PhaseFunctions(), merged), 1);
     const auto opened = SolvedAlone(scene, daemon.PhaseFunctions());
-    double largest = 0.0;
-    for (const v1::OrganLight& organ : result.organs()) {
-        largest = std::max(largest, std::abs(organ.bands(0).irradiance_lower_wm2() -
-                                             opened.at(organ.node()).irradianceLowerWm2));
-    }
-    EXPECT_GT(largest, 1e-3);  // the field changed the solve
+    EXPECT_GT(LargestLowerDifference(result, opened), 1e-3);  // the field changed the solve
 }
 
 // `push_down` with `output_level`: every organ of the plants solved whole is in the reply,
