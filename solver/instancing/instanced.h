@@ -88,8 +88,9 @@ struct InstancedOptions {
     // instances would all open, is solved as one local problem with them, their organs
     // among its own (InstanceTree::Merge), rather than with them closed and each opened in
     // turn: below some size a structure's own problem costs more than its leaves solved
-    // with its neighbours', and its phase function is not needed. Not with outputLevel.
-    // 0: every instance a problem of its own.
+    // with its neighbours', and its phase function is not needed. Ignored with outputLevel
+    // (the command line and the daemon refuse the two together). 0: every instance a problem
+    // of its own.
     std::int64_t mergeTriangles = 0;
 };
 
