@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <cstdio>
 #include <sstream>
 
@@ -20,6 +21,7 @@ int main(int argc, char** argv) {
     int cycles = 0;
     double epsilon = 0.0, spacing = 0.0, rowAzimuth = -1.0;
     int samples = 0;
+    std::int64_t mergeTriangles = -1;
     bool directOnly = false, warmStart = false;
     double statusTimeoutS = 30.0, cycleTimeoutS = 60.0, perOrganMs = 10.0;
     app.add_option("--scenario", scenarioPath, "Scenario file (growth_stub/scenarios/*.txtpb)")
@@ -66,6 +68,11 @@ int main(int argc, char** argv) {
                  "hrc, instanced: each cycle starts from the light of the last one "
                  "(SolverSettings.warm_start): the same light within a small part of what "
                  "epsilon costs, a few sweeps fewer");
+    app.add_option("--merge-triangles", mergeTriangles,
+                   "instanced: each opened instance of at most this many organ triangles is "
+                   "solved as one problem with the smaller instances it holds "
+                   "(InstancedSettings.merge_triangles; -1: the scenario's)")
+        ->check(CLI::Range(std::int64_t{-1}, std::int64_t{1} << 40));
     app.add_flag("--branch-light", options.branchLight,
                  "Ask for per-axis light only; each leaf gets its axis's (with --solver "
                  "instanced, instances are opened down to axes only)");
@@ -122,6 +129,14 @@ int main(int argc, char** argv) {
             if (const auto error = ReadTextFormat(
                     policyFile, *settings.mutable_instanced()->mutable_inline_policy()))
                 throw std::invalid_argument(error->where + ": " + error->what);
+        }
+        if (mergeTriangles >= 0) {
+            if (!instanced)
+                throw std::invalid_argument("--merge-triangles: only the instanced solver merges");
+            if (options.branchLight)
+                throw std::invalid_argument(
+                    "--merge-triangles: --branch-light keeps the small structures closed");
+            settings.mutable_instanced()->set_merge_triangles(mergeTriangles);
         }
         if (instanced && options.branchLight)
             settings.mutable_instanced()->set_output_level(v1::NODE_TYPE_AXIS);
