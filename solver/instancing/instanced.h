@@ -85,7 +85,8 @@ struct InstancedOptions {
     // cheaper, less accurate in scattered light.
     bool holdOutside = true;
     // An opened instance of at most this many organ triangles in all, whose smaller
-    // instances would all open, is solved as one local problem with them, their organs
+    // instances would all open by maxDepth (inView is not asked: those out of view are
+    // solved with the rest), is solved as one local problem with them, their organs
     // among its own (InstanceTree::Merge), rather than with them closed and each opened in
     // turn: below some size a structure's own problem costs more than its leaves solved
     // with its neighbours', and its phase function is not needed. Ignored with outputLevel
