@@ -286,25 +286,29 @@ def instancing_section():
     return "\n".join(table)
 
 
-def bench_rows(build, out, program, name, run):
+def bench_rows(build, out, program, name, run, args=()):
     """Runs tests/PROGRAM writing OUT/NAME (when `run`), keeps a copy in examples/report/ and
     returns its rows."""
     if run:
         os.makedirs(out, exist_ok=True)
-        subprocess.run([os.path.join(build, "tests", program), os.path.join(out, name)], check=True)
+        subprocess.run([os.path.join(build, "tests", program), os.path.join(out, name), *args], check=True)
         shutil.copy(os.path.join(out, name), os.path.join(REPORT, name))
     return list(csv.DictReader(open(os.path.join(REPORT, name))))
 
 
 def daemon_section(build, out, run=True):
     """Runs leaflux_bench_daemon: the median solve of a cycle of the growing plants, by solver,
-    database, start of the iteration and ε."""
-    rows = bench_rows(build, out, "leaflux_bench_daemon", "daemon_bench.csv", run)
+    database, start of the iteration and ε, also at the coarsest ε within DAEMON_GOAL_PCT
+    of each solver (daemon_coarsest: the daemon-accuracy part runs first)."""
+    coarsest = daemon_coarsest()
+    growths = sorted({(leaves, e) for (leaves, _), e in coarsest.items()}, key=lambda g: (g[0], float(g[1])))
+    rows = bench_rows(build, out, "leaflux_bench_daemon", "daemon_bench.csv", run,
+                      [f"{leaves}:{e}" for leaves, e in growths])
     names = {"growing_tree": "HRC", "growing_tree_warm_start": "HRC, warm start",
              "instanced_cold": "instanced, empty database",
              "instanced_warm": "instanced, the database filled",
              "instanced_warm_start": "instanced, the database filled, warm start",
-             "instanced_merged": "instanced, the database filled, merged below 4,096 triangles"}
+             "instanced_merged": f"instanced, the database filled, merged below {DAEMON_MERGE:,} triangles"}
     table = ["| solver | leaves | ε | median solve ms (10 cycles) | last cycle ms | sweeps (10 cycles) | "
              "phase functions computed |", "|---|---|---|---|---|---|---|"]
     keys = []
@@ -318,6 +322,36 @@ def daemon_section(build, out, run=True):
         table.append(f"| {names[what]} | {int(leaves):,} | {float(epsilon):.0e} | {number(solve)} | "
                      f"{number(cycle[-1]['solve_ms'])} | {sum(int(r['iterations']) for r in cycle)} | "
                      f"{sum(int(r['phase_computed']) for r in cycle)} |")
+    # The median cycle of each solver at its coarsest ε within the goal.
+    sessions = {"HRC": "growing_tree", "instanced": "instanced_warm", "instanced, merged": "instanced_merged"}
+    summary = []
+    for _, leaves in DAEMON_TREES:
+        cells = []
+        for label, what in sessions.items():
+            e = coarsest.get((leaves, label))
+            cycle = [float(r["solve_ms"]) for r in rows if r["what"] == what and int(r["leaves"]) == leaves
+                     and e is not None and float(r["epsilon"]) == float(e)]
+            if cycle:
+                cells.append(f"{label} {number(median(cycle))} ms at ε = {e}")
+        summary.append(f"{leaves:,} leaves: " + ", ".join(cells))
+    table += ["", f"The median cycle at the coarsest ε within {DAEMON_GOAL_PCT:g} % L2 in every band "
+              "(the instanced sessions on the database filled): " + "; ".join(summary) + ".", ""]
+
+    def ratios(what, against, column="solve_ms", statistic=median):
+        """By plant: the range over ε of `what`'s statistic of `column` over `against`'s."""
+        by = {}
+        for leaves, epsilon in {(int(r["leaves"]), r["epsilon"]) for r in rows if r["what"] == what}:
+            of = lambda w: statistic([float(r[column]) for r in rows if r["what"] == w and
+                                      int(r["leaves"]) == leaves and r["epsilon"] == epsilon])
+            by.setdefault(leaves, []).append(of(what) / of(against))
+        return " and ".join(f"{number(min(v))}–{number(max(v))} times for {leaves:,} leaves"
+                            for leaves, v in sorted(by.items()))
+    table.append("Over the ε above, against HRC's at the same ε, the instanced solver's median cycle from "
+                 f"a filled database takes {ratios('instanced_warm', 'growing_tree')}. Against the unmerged "
+                 f"one's, the merged takes {ratios('instanced_merged', 'instanced_warm')}. Against a start "
+                 "from the direct light, the warm start takes "
+                 f"{ratios('instanced_warm_start', 'instanced_warm', 'iterations', sum)} the sweeps over the "
+                 f"ten cycles, and {ratios('instanced_warm_start', 'instanced_warm')} the median cycle.")
     return "\n".join(table)
 
 
@@ -398,21 +432,55 @@ def rays_section(build, out, run=True):
 
 
 # The daemon's growing trees as scenes (no ground, 46-cone sky: ε relative to the plant's own
-# light) and the ε of its cycles: (name, leaves).
+# light) and the ε their cycles' accuracy is measured at: (name, leaves).
 DAEMON_TREES = [("tree1k_bare", 1000), ("tree10k_bare", 10000)]
-DAEMON_EPSILONS = ["1e-4", "3e-4", "1e-3", "3e-3"]
+DAEMON_EPSILONS = ["1e-4", "2e-4", "3e-4", "5e-4", "7e-4", "1e-3", "2e-3", "3e-3", "5e-3", "7e-3", "1e-2"]
 DAEMON_GOAL_PCT = 2.0  # the L2 error a cycle is asked to stay within, per band
+DAEMON_MERGE = 4096  # leaflux_bench_daemon's kMergeTriangles: the "merged" sessions' bound
+# The daemon's sessions by solver, as `leaflux bench error` names the same solves: label,
+# solver and what follows the ε in the run's setting.
+DAEMON_SOLVERS = {"HRC": ("hrc", []), "instanced": ("instanced", []),
+                  "instanced, merged": ("instanced", [f"merge-triangles={DAEMON_MERGE}"])}
+
+
+def daemon_accuracy_rows(name):
+    """The daemon-accuracy CSV of one tree: {(solver label, ε): [its rows, one per band]}."""
+    at = {}
+    for r in csv.DictReader(open(os.path.join(REPORT, f"daemon_accuracy_{name}.csv"))):
+        setting = r["setting"].split()
+        if not setting or not setting[0].startswith("epsilon="):
+            continue
+        epsilon = float(setting[0].split("=")[1])
+        for label, (solver, rest) in DAEMON_SOLVERS.items():
+            for e in DAEMON_EPSILONS:
+                if r["solver"] == solver and setting[1:] == rest and float(e) == epsilon:
+                    at.setdefault((label, e), []).append(r)
+    return at
+
+
+def daemon_coarsest():
+    """The coarsest ε of DAEMON_EPSILONS whose solve stays within DAEMON_GOAL_PCT in every
+    band, by tree and solver: {(leaves, solver label): ε}, from the daemon-accuracy CSVs."""
+    coarsest = {}
+    for name, leaves in DAEMON_TREES:
+        at = daemon_accuracy_rows(name)
+        within = [(label, e) for (label, e), rows in at.items()
+                  if all(float(r["l2_pct_of_max"]) <= DAEMON_GOAL_PCT for r in rows)]
+        for label, e in within:
+            if float(e) > float(coarsest.get((leaves, label), 0)):
+                coarsest[(leaves, label)] = e
+    return coarsest
 
 
 def daemon_accuracy_section(build, out, run=True):
     """`leaflux bench error` on the daemon's trees at the ε of its cycles, HRC and the
-    instanced solver (from the database its cold run filled): how much accuracy each ε
-    costs, and the coarsest ε within DAEMON_GOAL_PCT in every band."""
+    instanced solver (from the database its cold run filled), also merged: how much accuracy
+    each ε costs, and the coarsest ε within DAEMON_GOAL_PCT in every band."""
     leaflux = os.path.join(build, "server", "leaflux")
-    solvers = {"hrc": "HRC", "instanced": "instanced"}
-    table = ["| tree | solver | " + " | ".join(f"ε = {e}: L2 % of max, by band" for e in DAEMON_EPSILONS) + " |",
-             "|---|---|" + "---|" * len(DAEMON_EPSILONS)]
-    coarsest = []
+    table = ["| ε | " + " | ".join(f"{leaves:,} leaves, {label}" for _, leaves in DAEMON_TREES
+                                   for label in DAEMON_SOLVERS) + " |",
+             "|---|" + "---|" * (len(DAEMON_TREES) * len(DAEMON_SOLVERS))]
+    accuracy = {}
     for name, leaves in DAEMON_TREES:
         if run:
             os.makedirs(out, exist_ok=True)
@@ -422,26 +490,22 @@ def daemon_accuracy_section(build, out, run=True):
             subprocess.run([leaflux, "bench", "error", "--scene", scene, "--name", name, "--out", out,
                             "--cache", os.path.join(out, "cache"), "--no-mc", "--no-direct", "--no-plot",
                             "--hrc-epsilon", ",".join(DAEMON_EPSILONS),
-                            "--instanced-epsilon", ",".join(DAEMON_EPSILONS)], check=True)
+                            "--instanced-epsilon", ",".join(DAEMON_EPSILONS),
+                            "--instanced-merge", str(DAEMON_MERGE)], check=True)
             shutil.copy(os.path.join(out, f"{name}.csv"), os.path.join(REPORT, f"daemon_accuracy_{name}.csv"))
-        rows = list(csv.DictReader(open(os.path.join(REPORT, f"daemon_accuracy_{name}.csv"))))
-        for solver, label in solvers.items():
-            cells, within = [], None
-            for epsilon in DAEMON_EPSILONS:
-                # The plain run at this ε (not the variants beside it: cold, phase=bi, ...).
-                at = [r for r in rows if r["solver"] == solver and r["setting"].startswith("epsilon=")
-                      and " " not in r["setting"] and float(r["setting"].split("=")[1]) == float(epsilon)]
-                if not at:
-                    cells.append("–")
-                    continue
-                cells.append(" / ".join(f"{r['band']} {number(r['l2_pct_of_max'])}" for r in at))
-                if all(float(r["l2_pct_of_max"]) <= DAEMON_GOAL_PCT for r in at):
-                    within = epsilon
-            table.append(f"| {leaves:,} leaves | {label} | " + " | ".join(cells) + " |")
-            coarsest.append(f"{within} for the {leaves:,}-leaf plant with {label}" if within
-                            else f"none of these for the {leaves:,}-leaf plant with {label}")
-    table += ["", f"The coarsest ε whose cycles stay within {DAEMON_GOAL_PCT:g} % L2 in every band: "
-              + "; ".join(coarsest) + " (their times are in the daemon's tables above)."]
+        accuracy[leaves] = daemon_accuracy_rows(name)
+    for epsilon in DAEMON_EPSILONS:
+        cells = []
+        for _, leaves in DAEMON_TREES:
+            for label in DAEMON_SOLVERS:
+                rows = accuracy[leaves].get((label, epsilon))
+                cells.append(" / ".join(number(r["l2_pct_of_max"]) for r in rows) if rows else "–")
+        table.append(f"| {epsilon} | " + " | ".join(cells) + " |")
+    coarsest = daemon_coarsest()
+    found = [f"{leaves:,} leaves, {label}: {coarsest.get((leaves, label), 'none of these')}"
+             for _, leaves in DAEMON_TREES for label in DAEMON_SOLVERS]
+    table += ["", f"The coarsest ε whose solve stays within {DAEMON_GOAL_PCT:g} % L2 in every band: "
+              + "; ".join(found) + ". The daemon's cycles are timed at these ε too (the table above)."]
     return "\n".join(table)
 
 
@@ -709,12 +773,12 @@ def main():
             update(README, "pictures", render_sections(build, out, run=False)[1])  # the new series
         update(RESULTS, "demo", demo_section())
         update(RESULTS, "growth-instanced", instancing_section())
+    if "daemon-accuracy" in parts:  # first: the daemon's cycles are timed at the ε it finds
+        update(DAEMON_RESULTS, "daemon-accuracy",
+               daemon_accuracy_section(build, os.path.join(out, "daemon_accuracy"), run))
     if "daemon" in parts:
         update(DAEMON_RESULTS, "daemon", daemon_section(build, os.path.join(out, "daemon"), run))
         update(DAEMON_RESULTS, "daemon-protocol", daemon_protocol_section())
-    if "daemon-accuracy" in parts:
-        update(DAEMON_RESULTS, "daemon-accuracy",
-               daemon_accuracy_section(build, os.path.join(out, "daemon_accuracy"), run))
     if "soak" in parts:
         update(DAEMON_RESULTS, "soak", soak_section(build, os.path.join(out, "soak"), run))
     if "render" in parts:

@@ -210,6 +210,12 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
             runs.push_back(cold);
         }
         runs.push_back(run);
+        if (options.instancedMerge > 0) {
+            Run merged = run;
+            merged.setting += " merge-triangles=" + std::to_string(options.instancedMerge);
+            merged.settings.instanced.mergeTriangles = options.instancedMerge;
+            runs.push_back(merged);
+        }
         if (i == options.instancedEpsilons.size() / 2) {
             // Directional instance light against the paper's single value. Under a
             // mono-directional phase function an instance sends alike in every direction
@@ -248,12 +254,6 @@ std::vector<Run> Runs(const ErrorBenchOptions& options) {
             pushed.setting = run.setting + " output=axis pushed-down";
             pushed.settings.instanced.pushDown = true;
             runs.push_back(pushed);
-            if (options.instancedMerge > 0) {
-                Run merged = run;
-                merged.setting += " merge-triangles=" + std::to_string(options.instancedMerge);
-                merged.settings.instanced.mergeTriangles = options.instancedMerge;
-                runs.push_back(merged);
-            }
             for (int depth : options.instancedDepths) {
                 Run shallow = run;
                 shallow.setting += " depth=" + std::to_string(depth) + " per-structure";

@@ -36,14 +36,14 @@ struct ErrorBenchOptions {
     // the middle ε also directional instance light against the paper's single value (with
     // the phase function made bi-directional when the policy's is not: "phase=bi", first
     // "cold", computing its originals), the outside light per bin (per-bin), shadows by
-    // transmittance, light per branch (output=axis), small instances merged
-    // (instancedMerge) and opening down to each of `instancedDepths` only; a run that solved
-    // structures whole is compared on those structures' absorbed power per organ area
-    // (CompareWholeStructures), not on leaves.
+    // transmittance, light per branch (output=axis) and opening down to each of
+    // `instancedDepths` only; at every ε also with small instances merged (instancedMerge)
+    // when asked. A run that solved structures whole is compared on those structures'
+    // absorbed power per organ area (CompareWholeStructures), not on leaves.
     std::vector<double> instancedEpsilons;
     std::vector<int> instancedDepths;
-    // > 0: also at the middle ε with instances of at most this many organ triangles solved
-    // as one local problem with the instances they hold (InstancedOptions::mergeTriangles).
+    // > 0: also at every ε with instances of at most this many organ triangles solved as
+    // one local problem with the instances they hold (InstancedOptions::mergeTriangles).
     std::int64_t instancedMerge = 0;
     InstancingPolicy policy;
     int threads = 0;

@@ -146,7 +146,7 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 64));
     errorApp
         ->add_option("--instanced-merge", errorBench.instancedMerge,
-                     "Instanced runs at the middle ε also with instances of at most this many "
+                     "Instanced runs at every ε also with instances of at most this many "
                      "organ triangles solved as one local problem with those they hold "
                      "(--merge-triangles); 0: no such run")
         ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));

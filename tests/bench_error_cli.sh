@@ -71,5 +71,15 @@ status=0
     --sample-plants 5 --no-plot > "$out/toomany.log" 2>&1 || status=$?
 test $status -ne 0 && grep -q -- "--sample-plants" "$out/toomany.log" ||
     fail "more plants than the scene has should be refused: $(cat "$out/toomany.log")"
+# With --instanced-merge, a merged instanced run at each ε.
+"$leaflux" bench error --scene "$out/trees.scene.txtpb" --out "$out/error" --cache "$out/cache" \
+    --reference-samples 256 --mc-samples 16 --hrc-epsilon 1e-3 --no-direct --no-plot \
+    --instanced-epsilon 1e-3,3e-3 --instanced-merge 4096 > "$out/merged.log" 2>&1 ||
+    fail "merged instanced runs failed: $(cat "$out/merged.log")"
+for epsilon in 0.001 0.003; do
+    grep -q "^trees,120,instanced,epsilon=$epsilon merge-triangles=4096,NIR," "$out/error/trees.csv" ||
+        fail "no merged run at ε = $epsilon: $(cut -d, -f3-5 "$out/error/trees.csv")"
+done
 echo "leaflux bench error: reference cached and reused, damaged cache solved again, CSV written," \
-     "unwritable --out and --cache refused first, a sample of plants compared on their leaves"
+     "unwritable --out and --cache refused first, a sample of plants compared on their leaves," \
+     "merged instanced runs at every ε"

@@ -1,14 +1,16 @@
 // leafluxd over loopback TCP: the protocol's own cost (Status round trips, a cycle with an
 // empty delta, answered with the last cycle's light — with the organs' results or none —
 // or solved again when it asks other outputs) and the latency of cycles of a plant growing to
-// 1,000 leaves (HRC, ε = 1e-4, 3e-4 and 1e-3) and 10,000 leaves (ε = 1e-4 and 3e-4), one
+// 1,000 leaves (ε = 1e-4, 3e-4, 1e-3 and 3e-3) and 10,000 leaves (ε = 1e-4 and 3e-4), one
 // tenth of the plant added per cycle, each grown twice: from the direct light, and from the
 // last cycle's light (SolverSettings.warm_start); and the same plants with the instanced
 // solver, first on a new daemon's empty phase-function database (cold: the functions
 // computed as the plant's structures appear), then as a second session on the database the
 // first filled (warm: none computed), then a third on it with the warm start, and a fourth
 // with its small instances merged into the problems of those holding them.
-// Run: build/release/tests/leaflux_bench_daemon [out.csv, default out/bench/daemon_bench.csv]
+// Run: build/release/tests/leaflux_bench_daemon [out.csv [LEAVES:EPSILON ...]]
+// (default out/bench/daemon_bench.csv); each LEAVES:EPSILON grows one more plant (1,000 or
+// 10,000 leaves) at that ε, as those above but for the protocol's cost.
 #include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
 
@@ -100,7 +102,8 @@ struct Row {
 }  // namespace
 }  // namespace leaflux
 
-// The growing plants and the ε of their sessions: for each, up to the coarsest whose
+// The growing plants and the ε of their sessions, and the protocol's cost measured on each;
+// examples/bench_report.py adds, on the command line, the coarsest ε at which each solver's
 // cycles stay within 2 % L2 of the reference (docs/results_daemon.md).
 constexpr std::pair<int, double> kGrowths[] = {{1000, 1e-4}, {1000, 3e-4},  {1000, 1e-3},
                                                {1000, 3e-3}, {10000, 1e-4}, {10000, 3e-4}};
@@ -115,6 +118,19 @@ int main(int argc, char** argv) {
     // of each cycle and of the solver.
     spdlog::set_level(spdlog::level::warn);
     spdlog::cfg::load_env_levels();
+    std::vector<std::pair<int, double>> growths(std::begin(kGrowths), std::end(kGrowths));
+    for (int a = 2; a < argc; ++a) {
+        int leaves = 0;
+        double epsilon = 0.0;
+        if (std::sscanf(argv[a], "%d:%lf", &leaves, &epsilon) != 2 || leaves <= 0 ||
+            !(epsilon > 0.0)) {
+            std::fprintf(stderr, "growth %s: expected LEAVES:EPSILON, e.g. 1000:6e-3\n", argv[a]);
+            return 2;
+        }
+        if (std::find(growths.begin(), growths.end(), std::pair{leaves, epsilon}) == growths.end())
+            growths.emplace_back(leaves, epsilon);
+    }
+    std::sort(growths.begin(), growths.end());
     std::vector<Row> rows;
     Loopback daemon;
     {
@@ -155,13 +171,16 @@ int main(int argc, char** argv) {
         }
         return session;
     };
-    for (const auto& [leaves, epsilon] : kGrowths) {
+    for (const auto& [leaves, epsilon] : growths) {
         v1::SolverSettings settings;
         settings.set_epsilon(epsilon);
         settings.set_warm_start(true);
         grow(daemon, "growing_tree_warm_start", leaves, settings);
         settings.set_warm_start(false);
         const std::string session = grow(daemon, "growing_tree", leaves, settings);
+        if (std::find(std::begin(kGrowths), std::end(kGrowths), std::pair{leaves, epsilon}) ==
+            std::end(kGrowths))
+            continue;
         // The same plant again with nothing changed. Asking what the last cycle asked, its
         // light comes back unsolved: the protocol alone and the organs' results (median of
         // kRepeats calls). Asking other outputs (none), it is solved again: validation,
@@ -190,7 +209,7 @@ int main(int argc, char** argv) {
         unchanged(false, 1, "empty_resolve");
         unchanged(false, kRepeats, "empty_nothing");
     }
-    for (const auto& [leaves, epsilon] : kGrowths) {
+    for (const auto& [leaves, epsilon] : growths) {
         v1::SolverSettings settings;
         settings.set_solver(v1::SOLVER_KIND_INSTANCED);
         settings.set_epsilon(epsilon);
