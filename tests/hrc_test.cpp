@@ -527,6 +527,28 @@ TEST(HrcExposure, SharesOutTheLightAClusterGathersTowardsTheOpenLeaf) {
     }
 }
 
+// A sun's light reaches each organ by the organ's own rays, whatever ε
+// (DirectionalSource::eachOrgan): at ε = 0.05, a link from a vertical sun into the stacked
+// plant, 2 % of the sun's power on the organs beside a 2 m black leaf, is within ε, and it
+// would hand the top leaf and the one it shades alike half of the sun each. Split to the
+// leaves, the top one takes all the sun and the one beneath none (black leaves: no light
+// but the sun's).
+TEST(HrcSources, ASunLightsEachOrganByItsOwnRaysAtACoarseEpsilon) {
+    Scene scene = OneBandScene({{"leaf", Leaf(0.0, 0.0)}});
+    AddStackedPlant(scene, "leaf", "leaf");
+    scene.nodes.push_back(OrganNode(3, "beside",
+                                     Quad({2.0, -1.0, 1.0}, {4.0, -1.0, 1.0}, {4.0, 1.0, 1.0},
+                                          {2.0, 1.0, 1.0}),
+                                     "leaf"));
+    scene.sources.suns.push_back(SunAt(90.0, 0.0, 1000.0));
+    scene.Validate();
+    const PreparedScene prepared(scene);
+    const Solution hrc = Solve(prepared, HrcSettings(0.05));
+    EXPECT_NEAR(hrc.light[0][0].irradianceUpperWm2, 1000.0, 1e-9 * 1000.0);  // top
+    EXPECT_NEAR(hrc.light[1][0].irradianceUpperWm2, 0.0, 1e-9 * 1000.0);     // bottom
+    EXPECT_NEAR(hrc.light[2][0].irradianceUpperWm2, 1000.0, 1e-9 * 1000.0);  // beside
+}
+
 // Sending, a cluster needs no exposure of its own: a link's rays run from the receiver to
 // points of the sender cluster weighted by what each sends (LinkVisibility::Between), so
 // they meet the cluster's own leaves in the way. Two leaves of one plant (ρ = 0.5 on top,

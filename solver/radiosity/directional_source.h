@@ -21,6 +21,10 @@ struct DirectionalSource {
     // Light incident on the scene, which its energy balance counts: the suns' and sky's,
     // not light scattered inside it.
     bool incident = true;
+    // Its links reach each organ, whatever they carry (Refiner::JudgeSource): a sun's. A
+    // link into a cluster hands every organ under it one visibility, sunlit and shaded
+    // alike; a sun brings most of the light and its shadow edges fall between leaves.
+    bool eachOrgan = false;
     // A sky cone reaching below the horizon has that part folded back above it, as the
     // reference takes it (FoldAtHorizon): its directions then, 8 × 8 of equal solid angle,
     // mirrored where below, and their mean.

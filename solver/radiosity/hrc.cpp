@@ -59,8 +59,11 @@ std::vector<DirectionalSource> BeamsOf(const Scene& scene, SkyDiscretization sky
         if (total <= 0.0) return static_cast<DirectionalSource*>(nullptr);
         return &sources.emplace_back(std::move(source));
     };
-    for (const Sun& sun : scene.sources.suns)
-        add(sun.towardSun, sun.normalIrradianceWm2, std::cos(sun.angularRadiusRad));
+    for (const Sun& sun : scene.sources.suns) {
+        if (DirectionalSource* added =
+                add(sun.towardSun, sun.normalIrradianceWm2, std::cos(sun.angularRadiusRad)))
+            added->eachOrgan = true;
+    }
     for (const Sky& sky : scene.sources.skies) {
         Sky discrete = sky;
         if (discrete.discretization == SkyDiscretization::kContinuous)

@@ -31,8 +31,9 @@ NodeModel::NodeModel(Hierarchy& hierarchy, const Scene& scene, const RayScene& r
     AssignSlots();
 }
 
-// Marks the clusters with an organ under them (a cluster's children come before it), and
-// finds the organs' bounds and each triangle's depth of subdivision.
+// Marks the clusters with an organ under them and those within one organ (a cluster's
+// children come before it), and finds the organs' bounds and each triangle's depth of
+// subdivision.
 void NodeModel::FindOrgans() {
     glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
     for (const Triangle& t : flat_.triangles) {
@@ -56,12 +57,14 @@ void NodeModel::FindOrgans() {
                                                  std::max(maxSubdivision_, kMaxSurfaceDepth)));
     }
     organs_.assign(hierarchy_.Size(), 0);
+    organOf_.assign(hierarchy_.Size(), kNoOrgan);
     held_.assign(hierarchy_.Size(), 0);
     emitters_.assign(hierarchy_.Size(), 0);
     for (std::uint32_t n = 0; n < hierarchy_.Size(); ++n) {
         const HrcNode& node = hierarchy_[n];
         if (node.patch) {
             organs_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kOrgan;
+            if (organs_[n]) organOf_[n] = node.receiver;
             emitters_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kEmitter;
             held_[n] = flat_.receivers[node.receiver].kind == ReceiverKind::kHeld ? kAllHeld : 0;
         } else if (node.closed >= 0) {
@@ -70,7 +73,9 @@ void NodeModel::FindOrgans() {
             held_[n] = held ? kAllHeld : 0;
         } else {
             bool all = !node.children.empty(), any = false;
+            organOf_[n] = node.children.empty() ? kNoOrgan : organOf_[node.children.front()];
             for (std::uint32_t child : node.children) {
+                if (organOf_[child] != organOf_[n]) organOf_[n] = kNoOrgan;
                 organs_[n] |= organs_[child];
                 emitters_[n] |= emitters_[child];
                 all = all && held_[child] == kAllHeld;

@@ -82,6 +82,12 @@ class NodeModel {
     bool PartlyHeld(std::uint32_t n) const {
         return !hierarchy_[n].patch && held_[n] == kPartlyHeld;
     }
+    // n lies within one organ: a patch of it, or a cluster of its triangles alone.
+    bool OneOrgan(std::uint32_t n) const {
+        const HrcNode& node = hierarchy_[n];
+        return node.patch ? flat_.receivers[node.receiver].kind == ReceiverKind::kOrgan
+                          : organOf_[n] != kNoOrgan;
+    }
     // n is an organ's patch, or a cluster with organs under it.
     bool HoldsOrgans(std::uint32_t n) const {
         const HrcNode& node = hierarchy_[n];
@@ -204,6 +210,8 @@ class NodeModel {
     std::vector<std::uint8_t> lampOf_;  // by receiver: Lamp of its patches
     std::vector<std::uint8_t> lamps_;   // by node as built: Lamp
     std::vector<std::uint8_t> organs_;  // by node as built: 1 over an organ
+    static constexpr std::uint32_t kNoOrgan = 0xFFFFFFFFu;
+    std::vector<std::uint32_t> organOf_;  // by node as built: the one organ it lies in
     static constexpr std::uint8_t kPartlyHeld = 1, kAllHeld = 2;
     std::vector<std::uint8_t> held_;      // by node as built: Held, PartlyHeld
     std::vector<std::uint8_t> emitters_;  // by node as built: an emitter under it
