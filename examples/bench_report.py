@@ -41,14 +41,14 @@ SCENES = {
                ["--reference-samples", "8192", "--hrc-epsilon", "1e-3,1e-4,1e-5,1e-6"]),
     "tree10k": (["--leaves", "10000", "--seed", "2", "--sky-cones", "turtle46"],
                 "generated tree, 10,000 leaves, sun + 46-cone overcast sky",
-                ["--reference-samples", "8192", "--hrc-epsilon", "1e-3,1e-4,5e-5,1e-5,1e-6",
-                 "--instanced-epsilon", "1e-3,1e-4,1e-5", "--instanced-depth", "2,3",
+                ["--reference-samples", "8192", "--hrc-epsilon", "1e-2,1e-3,1e-4,5e-5,1e-5,1e-6",
+                 "--instanced-epsilon", "1e-2,1e-3,1e-4,1e-5", "--instanced-depth", "2,3",
                  "--instanced-merge", "4096"]),
     "tree119k": (["--leaves", "44500", "--seed", "2", "--sky-cones", "turtle46"],
                  "generated tree of 119k triangles (44,500 leaves and their internodes), "
                  "sun + 46-cone overcast sky",
-                 ["--reference-samples", "4096", "--hrc-epsilon", "1e-3,1e-4,1e-5",
-                  "--instanced-epsilon", "1e-3,1e-4,1e-5", "--instanced-depth", "3,4",
+                 ["--reference-samples", "4096", "--hrc-epsilon", "1e-2,1e-3,1e-4,1e-5",
+                  "--instanced-epsilon", "1e-2,1e-3,1e-4,1e-5", "--instanced-depth", "3,4",
                   "--instanced-merge", "4096"]),
     "canopy": (["--random-canopy", "--canopy-leaves", "2000", "--lai", "5", "--canopy-width", "2",
                 "--seed", "3", "--sky-cones", "turtle46"],
@@ -434,7 +434,8 @@ def rays_section(build, out, run=True):
 # The daemon's growing trees as scenes (no ground, 46-cone sky: ε relative to the plant's own
 # light) and the ε their cycles' accuracy is measured at: (name, leaves).
 DAEMON_TREES = [("tree1k_bare", 1000), ("tree10k_bare", 10000)]
-DAEMON_EPSILONS = ["1e-4", "2e-4", "3e-4", "5e-4", "7e-4", "1e-3", "2e-3", "3e-3", "5e-3", "7e-3", "1e-2"]
+DAEMON_EPSILONS = ["1e-4", "2e-4", "3e-4", "5e-4", "7e-4", "1e-3", "2e-3", "3e-3", "5e-3", "7e-3", "1e-2", "2e-2",
+                   "5e-2", "1e-1"]
 DAEMON_GOAL_PCT = 2.0  # the L2 error a cycle is asked to stay within, per band
 DAEMON_MERGE = 4096  # leaflux_bench_daemon's kMergeTriangles: the "merged" sessions' bound
 # The daemon's sessions by solver, as `leaflux bench error` names the same solves: label,
