@@ -536,10 +536,9 @@ TEST(HrcExposure, SharesOutTheLightAClusterGathersTowardsTheOpenLeaf) {
 TEST(HrcSources, ASunLightsEachOrganByItsOwnRaysAtACoarseEpsilon) {
     Scene scene = OneBandScene({{"leaf", Leaf(0.0, 0.0)}});
     AddStackedPlant(scene, "leaf", "leaf");
-    scene.nodes.push_back(OrganNode(3, "beside",
-                                     Quad({2.0, -1.0, 1.0}, {4.0, -1.0, 1.0}, {4.0, 1.0, 1.0},
-                                          {2.0, 1.0, 1.0}),
-                                     "leaf"));
+    scene.nodes.push_back(OrganNode(
+        3, "beside", Quad({2.0, -1.0, 1.0}, {4.0, -1.0, 1.0}, {4.0, 1.0, 1.0}, {2.0, 1.0, 1.0}),
+        "leaf"));
     scene.sources.suns.push_back(SunAt(90.0, 0.0, 1000.0));
     scene.Validate();
     const PreparedScene prepared(scene);

@@ -9,8 +9,8 @@
 // first filled (warm: none computed), then a third on it with the warm start, and a fourth
 // with its small instances merged into the problems of those holding them.
 // Run: build/release/tests/leaflux_bench_daemon [out.csv [LEAVES:EPSILON ...]]
-// (default out/bench/daemon_bench.csv); each LEAVES:EPSILON grows one more plant (1,000 or
-// 10,000 leaves) at that ε, as those above but for the protocol's cost.
+// (default out/bench/daemon_bench.csv); each LEAVES:EPSILON grows one more tree of LEAVES
+// leaves at that ε, as those above but for the protocol's cost.
 #include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
 
