@@ -82,17 +82,15 @@ class NodeModel {
     bool PartlyHeld(std::uint32_t n) const {
         return !hierarchy_[n].patch && held_[n] == kPartlyHeld;
     }
-    // n lies within one organ: a patch of it, or a cluster of its triangles alone.
-    bool OneOrgan(std::uint32_t n) const {
-        const HrcNode& node = hierarchy_[n];
-        return node.patch ? flat_.receivers[node.receiver].kind == ReceiverKind::kOrgan
-                          : organOf_[n] != kNoOrgan;
-    }
     // n is an organ's patch, or a cluster with organs under it.
     bool HoldsOrgans(std::uint32_t n) const {
         const HrcNode& node = hierarchy_[n];
         return node.patch ? flat_.receivers[node.receiver].kind == ReceiverKind::kOrgan
                           : organs_[n] != 0;
+    }
+    // n lies within one organ: a patch of it, or a cluster of its triangles alone.
+    bool OneOrgan(std::uint32_t n) const {
+        return hierarchy_[n].patch ? HoldsOrgans(n) : organOf_[n] != kNoOrgan;
     }
     // How much a node's own error matters to the organs, as a factor on its links'
     // threshold: 1 for organs. A surface's error reaches the organs only through the light
