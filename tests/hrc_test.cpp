@@ -527,13 +527,13 @@ TEST(HrcExposure, SharesOutTheLightAClusterGathersTowardsTheOpenLeaf) {
     }
 }
 
-// A sun's light reaches each organ by the organ's own rays, whatever ε
-// (DirectionalSource::eachOrgan): at ε = 0.05, a link from a vertical sun into the stacked
-// plant, 2 % of the sun's power on the organs beside a 2 m black leaf, is within ε, and it
+// A sun's light reaches each organ by the organ's own lit share (the sun's map, or rays),
+// whatever ε (DirectionalSource::eachOrgan): at ε = 0.05, a link from a vertical sun into the
+// stacked plant, 2 % of the sun's power on the organs beside a 2 m black leaf, is within ε, and it
 // would hand the top leaf and the one it shades alike half of the sun each. Split to the
 // leaves, the top one takes all the sun and the one beneath none (black leaves: no light
 // but the sun's).
-TEST(HrcSources, ASunLightsEachOrganByItsOwnRaysAtACoarseEpsilon) {
+TEST(HrcSources, ASunLightsEachOrganByItsOwnShareAtACoarseEpsilon) {
     Scene scene = OneBandScene({{"leaf", Leaf(0.0, 0.0)}});
     AddStackedPlant(scene, "leaf", "leaf");
     scene.nodes.push_back(OrganNode(

@@ -34,7 +34,8 @@ using testing::Copies, testing::Hrc, testing::Plants, testing::PlantsInstanced;
 // leaves absorb in the flattened scene (APlantSolvedWholeAbsorbsWhatItsLeavesDo).
 constexpr double kWholeTolerance[2] = {0.05, 0.05};
 
-// A policy that finds no structure: one level, the whole scene, as HRC solves it.
+// A policy that finds no structure: one level, the whole scene, as HRC solves it (its
+// suns' maps over the same triangles).
 TEST(Instanced, WithoutInstancesItIsHrc) {
     const Scene scene = Copies(2, 60);
     const PreparedScene prepared(scene);
@@ -45,7 +46,7 @@ TEST(Instanced, WithoutInstancesItIsHrc) {
     InstancedOptions options;
     options.hrc.epsilon = 1e-4;
     const InstancedSolution instanced =
-        SolveInstanced(scene, prepared.Flat(), nullptr, none, database, options);
+        SolveInstanced(scene, prepared.Flat(), &prepared.Rays(), none, database, options);
     ASSERT_EQ(instanced.stats.depths.size(), 1u);
     EXPECT_EQ(instanced.stats.originalsComputed, 0);
     for (std::size_t r = 0; r < hrc.light.size(); ++r) {

@@ -94,6 +94,7 @@ class InstancedSolve {
     }
 
     void Run() {
+        if (shadows_ != nullptr) DrawSuns();
         const std::unique_ptr<Level> top = Build(InstanceTree::kTop, glm::dmat4(1.0), nullptr, 0);
         LevelSolution light = Solve(InstanceTree::kTop, *top, {});
         if (options_.hrc.directOnly) {
@@ -176,6 +177,14 @@ class InstancedSolve {
         return organs;
     }
     ShadowView ShadowsOf(std::uint32_t p, const FlatScene& flat) const;
+    // A map of each sun over the whole scene's triangles (SunMap): the light of the suns on
+    // every organ, found once for all the levels.
+    void DrawSuns() {
+        std::vector<SunMaps::Sun> suns;
+        for (const Sun& sun : scene_.sources.suns)
+            suns.push_back({sun.towardSun, std::cos(sun.angularRadiusRad)});
+        sunMaps_ = SunMaps(*shadows_, receivers_, suns);
+    }
     // The light that arrived on closed instance c of `level`, as the sources of its contents.
     std::vector<DirectionalSource> ArrivedOn(const LevelSolution& light, std::size_t c) const;
     // Each patch side that sends light, as an emitter held fixed (ReceiverKind::kHeld).
@@ -214,6 +223,7 @@ class InstancedSolve {
     const Scene& scene_;
     const FlatScene& receivers_;
     const RayScene* const shadows_;
+    SunMaps sunMaps_;  // over shadows_, when it is given
     const InstanceTree& tree_;
     const SceneOriginals& originals_;
     const InstancedOptions options_;  // directOnly: holdOutside off (DirectOnlyAlone)
@@ -315,7 +325,7 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
 ShadowView InstancedSolve::ShadowsOf(std::uint32_t p, const FlatScene& flat) const {
     if (shadows_ == nullptr) return {};
     ShadowView view{shadows_, std::vector<std::uint32_t>(flat.triangles.size(), kNoTriangle),
-                    flat.origin - receivers_.origin, organTriangles_};
+                    flat.origin - receivers_.origin, organTriangles_, &sunMaps_};
     const std::uint32_t organs = OrganCount(flat);
     for (std::uint32_t r = 0; r < OwnReceivers(p, flat); ++r) {
         const Receiver& local = flat.receivers[r];

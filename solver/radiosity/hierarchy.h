@@ -96,6 +96,12 @@ class Hierarchy {
     // By flat triangle, its place in hierarchy order: a node's original triangles are
     // those placed in [first, first + count).
     const std::uint32_t* Ranks() const { return orderOf_.data(); }
+    // The flat triangle in place `place` of hierarchy order, or kNoTriangle for a closed
+    // instance there.
+    std::uint32_t TriangleAt(std::uint32_t place) const {
+        const std::uint32_t entry = triangleOrder_[place];
+        return entry & kClosedEntry ? kNoTriangle : entry;
+    }
 
     // Whether the point x of flat triangle `triangle` lies on the node's surfaces.
     bool Covers(std::uint32_t node, std::uint32_t triangle, const glm::dvec3& x) const;

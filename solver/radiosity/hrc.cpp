@@ -97,6 +97,17 @@ std::vector<DirectionalSource> UnitBeams(const Channels& channels,
     return sources;
 }
 
+// The maps of a whole scene's suns, for the links into its organs (eachOrgan): none in a
+// scene with closed instances, whose transmittance no map holds.
+SunMaps DrawSuns(const FlatScene& flat, const RayScene& rays,
+                 std::span<const DirectionalSource> sources) {
+    std::vector<SunMaps::Sun> suns;
+    for (const DirectionalSource& source : sources) {
+        if (source.eachOrgan && source.beyond) suns.push_back({source.toward, source.cosRadius});
+    }
+    return suns.empty() ? SunMaps{} : SunMaps(rays, flat, suns);
+}
+
 class SceneSolve {
   public:
     // The scene's suns and sky cones, a channel per band.
@@ -130,9 +141,10 @@ class SceneSolve {
                                         : std::make_unique<Occlusion>(rays, ProxiesOf(closed))),
           occlusion_(level.occlusion ? *level.occlusion : *ownOcclusion_),
           level_(level),
+          sunMaps_(level.occlusion || !closed.empty() ? SunMaps{} : DrawSuns(flat, rays, sources_)),
           estimator_(model_, field_),
           visibility_(model_, field_, occlusion_, options.visibilityRays, options.sourceRays,
-                      sources_),
+                      sources_, sunMaps_.maps.empty() ? nullptr : &sunMaps_),
           pushPull_(model_, traversal_, exposure_) {
         field_.Resize(hierarchy_.Size());
         field_.intensity.Assign(model_.SlotCount());
@@ -289,6 +301,7 @@ class SceneSolve {
     Links links_;
     Traversal traversal_;
     Exposure exposure_;
+    const SunMaps sunMaps_;  // of a whole scene's suns over its triangles (DrawSuns)
     const Estimator estimator_;
     const LinkVisibility visibility_;
     PushPull pushPull_;

@@ -149,6 +149,22 @@ Refiner::Verdict Refiner::JudgeSource(std::uint32_t r, std::uint32_t s) const {
     // The spread is least when every ray agrees: beyond ε even then, no ray can save
     // the link, and none is traced.
     const double threshold = SourceThreshold(r);
+    // Into an organ, with the sun's map: its lit share, found without rays. Handed evenly
+    // over the organ, it is off where the organ is partly lit, by as much as rays that
+    // all agree would be (VisibilitySpread of a share without their noise): so it is split
+    // as rays would split it, and a part of a triangle takes rays.
+    if (source.eachOrgan && model_.OneOrgan(r)) {
+        if (const std::optional<double> lit = visibility_.Mapped(r, s)) {
+            if (unoccluded * 2.0 * std::sqrt(*lit * (1.0 - *lit)) > threshold && CanSplit(r))
+                return Verdict::Of(Verdict::kSplitReceiver);
+            Verdict verdict;
+            if (*lit > 0.0) {
+                verdict.kind = Verdict::kLink;
+                verdict.visibility = static_cast<float>(*lit);
+            }
+            return verdict;
+        }
+    }
     if (unoccluded * VisibilitySpread(1.0, visibility_.SourceRays(s)) > threshold && CanSplit(r))
         return Verdict::Of(Verdict::kSplitReceiver);
     // Into one organ, such a source's link is all of its light the organ gets, and its

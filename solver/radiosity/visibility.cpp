@@ -98,7 +98,7 @@ std::vector<int> SourceRayCounts(std::span<const DirectionalSource> sources,
 
 LinkVisibility::LinkVisibility(const NodeModel& model, const Field& field,
                                const Occlusion& occlusion, int visibilityRays, int sourceRays,
-                               std::span<const DirectionalSource> sources)
+                               std::span<const DirectionalSource> sources, const SunMaps* suns)
     : hierarchy_(model.Nodes()),
       model_(model),
       field_(field),
@@ -112,6 +112,45 @@ LinkVisibility::LinkVisibility(const NodeModel& model, const Field& field,
         }
         sourceSampling_.push_back({&RankOneLattice::Of(count), rings, count / rings});
     }
+    if (suns == nullptr && occlusion.Shadows().rays != nullptr) {
+        suns = occlusion.Shadows().suns;
+        mapTriangleOf_ = &occlusion.Shadows().triangleOf;
+    }
+    for (const DirectionalSource& source : sources) {
+        sunMap_.push_back(suns != nullptr && source.eachOrgan && source.beyond
+                              ? suns->Of(source.toward, source.cosRadius)
+                              : nullptr);
+    }
+}
+
+std::optional<double> LinkVisibility::Mapped(std::uint32_t r, std::uint32_t source) const {
+    const SunMap* map = sunMap_[source];
+    const HrcNode& node = hierarchy_[r];
+    if (map == nullptr || node.closed >= 0 || (node.patch && node.depth > 0)) return std::nullopt;
+    const FlatScene& flat = hierarchy_.Flat();
+    double lit = 0.0, total = 0.0, missed = 0.0;
+    const auto add = [&](std::uint32_t t) {
+        const Triangle& triangle = flat.triangles[t];
+        const double weight =
+            triangle.areaM2 * model_.ReceivingWeight(t, triangle.normal, map->Toward());
+        if (weight <= 0.0) return;
+        const std::uint32_t whole = mapTriangleOf_ ? (*mapTriangleOf_)[t] : t;
+        const double share = whole == kNoTriangle ? -1.0 : map->Lit(whole);
+        if (share < 0.0) {
+            missed += weight;
+            return;
+        }
+        lit += weight * share, total += weight;
+    };
+    if (node.patch) {
+        add(node.triangle);
+    } else {
+        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+            if (const std::uint32_t t = hierarchy_.TriangleAt(i); t != kNoTriangle) add(t);
+        }
+    }
+    if (total <= 0.0 && missed > 0.0) return std::nullopt;
+    return total > 0.0 ? lit / total : 0.0;
 }
 
 double LinkVisibility::ClosedBrightness(std::int32_t closed, const glm::dvec3& towardQ) const {

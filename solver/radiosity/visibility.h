@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -77,8 +78,11 @@ class LinkVisibility {
                              const ClosedNode* inside = nullptr) const;
     // `sourceRays`: the rays of a link from a source of `sources`, more from one that brings
     // much of the light (SourceRayCounts).
+    // `suns`: the maps of the suns over the hierarchy's own triangles (the whole scene's
+    // for a level with the whole scene's shadows, ShadowView::suns).
     LinkVisibility(const NodeModel& model, const Field& field, const Occlusion& occlusion,
-                   int visibilityRays, int sourceRays, std::span<const DirectionalSource> sources);
+                   int visibilityRays, int sourceRays, std::span<const DirectionalSource> sources,
+                   const SunMaps* suns = nullptr);
 
     int VisibilityRays() const { return visibilityRays_; }
     // The rays estimating the visibility of a link from source s.
@@ -141,6 +145,10 @@ class LinkVisibility {
     // left it 5 % off.
     double FromSource(std::uint32_t r, std::uint32_t source, const DirectionalSource& light,
                       RaySet set, std::int64_t& rays, int rounds = 1) const;
+    // The lit fraction of organ node r's area as its sun's map has it (SunMap), weighted
+    // as FromSource weights its points; none where source s has no map, or r is a part of
+    // a triangle, or no pixel of the map fell on its triangles that take the light.
+    std::optional<double> Mapped(std::uint32_t r, std::uint32_t source) const;
 
   private:
     // The direct light on a point of closed instance c's organs from a light (unit
@@ -196,6 +204,10 @@ class LinkVisibility {
         int rings, turns;
     };
     std::vector<SourceSampling> sourceSampling_;
+    // Per source, its map (a sun's), or null; and where the map's triangles are the whole
+    // scene's, the whole scene's triangle of each of the hierarchy's (ShadowView).
+    std::vector<const SunMap*> sunMap_;
+    const std::vector<std::uint32_t>* mapTriangleOf_ = nullptr;
 };
 
 }  // namespace leaflux

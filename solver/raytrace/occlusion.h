@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "solver/raytrace/raytrace.h"
+#include "solver/raytrace/sun_map.h"
 
 namespace leaflux {
 
@@ -60,6 +61,7 @@ struct ShadowView {
     std::vector<std::uint32_t> triangleOf;
     glm::dvec3 offset{0.0};
     std::uint32_t organTriangles = 0;  // the whole scene's first triangles are its organs'
+    const SunMaps* suns = nullptr;     // the suns' light on those organs, where drawn
 };
 
 class Occlusion {

@@ -1,0 +1,307 @@
+#include "solver/raytrace/sun_map.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <span>
+
+#include "solver/util/check.h"
+
+namespace leaflux {
+namespace {
+
+constexpr int kTile = 128;                       // pixels a side of a tile
+constexpr std::int64_t kMostTiles = 1 << 22;     // of the plane over the organs
+constexpr std::uint32_t kNoOwner = 0xFFFFFFFFu;  // a pixel no triangle covers
+
+// The plane across a direction of light: pixel (i, j) has its centre at
+// origin + size (i + ½, j + ½) along u and v; depth grows towards the light.
+struct Plane {
+    glm::dvec3 u{0.0}, v{0.0}, toward{0.0};
+    glm::dvec2 origin{0.0};
+    double size = 0.0;  // m a pixel side
+    std::int64_t width = 0, height = 0;
+    std::int64_t tilesAcross = 0, tilesDown = 0;
+
+    Plane(const glm::dvec3& w) : toward(w) {
+        const glm::dvec3 a =
+            std::abs(w.x) < 0.9 ? glm::dvec3(1.0, 0.0, 0.0) : glm::dvec3(0.0, 1.0, 0.0);
+        u = glm::normalize(glm::cross(a, w));
+        v = glm::cross(w, u);
+    }
+    glm::dvec2 Across(const glm::dvec3& x) const { return {glm::dot(x, u), glm::dot(x, v)}; }
+};
+
+// A triangle on the plane: corners in pixels, ordered anticlockwise, with their depths,
+// and the pixels whose centres its box holds (clipped to the plane).
+struct Drawn {
+    glm::dvec2 p[3];
+    double depth[3];
+    double area2 = 0.0;  // twice its area in pixels; 0: it covers no pixel centre
+    std::int64_t x0 = 0, x1 = -1, y0 = 0, y1 = -1;
+};
+
+Drawn Draw(const RayScene& scene, const Plane& plane, std::uint32_t t) {
+    const std::array<glm::dvec3, 3> corners = scene.Corners(t);
+    Drawn d;
+    for (int k = 0; k < 3; ++k) {
+        d.p[k] = (plane.Across(corners[k]) - plane.origin) / plane.size;
+        d.depth[k] = glm::dot(corners[k], plane.toward);
+    }
+    d.area2 = (d.p[1].x - d.p[0].x) * (d.p[2].y - d.p[0].y) -
+              (d.p[2].x - d.p[0].x) * (d.p[1].y - d.p[0].y);
+    if (d.area2 < 0.0) {
+        std::swap(d.p[1], d.p[2]);
+        std::swap(d.depth[1], d.depth[2]);
+        d.area2 = -d.area2;
+    }
+    if (!(d.area2 > 0.0)) return d;
+    const auto first = [](double lo) { return static_cast<std::int64_t>(std::ceil(lo - 0.5)); };
+    const auto last = [](double hi) { return static_cast<std::int64_t>(std::floor(hi - 0.5)); };
+    const double xMin = std::min({d.p[0].x, d.p[1].x, d.p[2].x});
+    const double xMax = std::max({d.p[0].x, d.p[1].x, d.p[2].x});
+    const double yMin = std::min({d.p[0].y, d.p[1].y, d.p[2].y});
+    const double yMax = std::max({d.p[0].y, d.p[1].y, d.p[2].y});
+    // Far off the plane (a ground's far corners): clipped before they are rounded.
+    const double w = static_cast<double>(plane.width), h = static_cast<double>(plane.height);
+    d.x0 = first(std::max(xMin, 0.0)), d.x1 = last(std::min(xMax, w));
+    d.y0 = first(std::max(yMin, 0.0)), d.y1 = last(std::min(yMax, h));
+    d.x0 = std::max<std::int64_t>(d.x0, 0), d.x1 = std::min(d.x1, plane.width - 1);
+    d.y0 = std::max<std::int64_t>(d.y0, 0), d.y1 = std::min(d.y1, plane.height - 1);
+    return d;
+}
+
+// The pixel counts of the organ triangles under one direction of light.
+struct Counts {
+    std::vector<std::uint32_t> covered, lit;
+    std::int64_t fragments = 0;
+    double pixelM = 0.0;
+};
+
+// Draws the scene's triangles across `toward` into `counts`: per organ triangle, the pixels
+// it covers and those where it is the nearest to the light.
+void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t organs,
+               const glm::dvec3& toward, double pixelsPerTriangle, Counts& counts) {
+    Plane plane(toward);
+    // The organs' extent and mean area across the light, which size the pixel.
+    struct Extent {
+        glm::dvec2 lo{std::numeric_limits<double>::infinity()};
+        glm::dvec2 hi{-std::numeric_limits<double>::infinity()};
+        double area = 0.0;
+        std::int64_t count = 0;
+    };
+    const Extent extent = tbb::parallel_reduce(
+        tbb::blocked_range<std::uint32_t>(0, organs), Extent{},
+        [&](const tbb::blocked_range<std::uint32_t>& range, Extent e) {
+            for (std::uint32_t t = range.begin(); t != range.end(); ++t) {
+                const std::array<glm::dvec3, 3> c = scene.Corners(t);
+                glm::dvec2 p[3];
+                for (int k = 0; k < 3; ++k) {
+                    p[k] = plane.Across(c[k]);
+                    e.lo = glm::min(e.lo, p[k]), e.hi = glm::max(e.hi, p[k]);
+                }
+                const double area = 0.5 * std::abs((p[1].x - p[0].x) * (p[2].y - p[0].y) -
+                                                   (p[2].x - p[0].x) * (p[1].y - p[0].y));
+                if (area > 0.0) e.area += area, ++e.count;
+            }
+            return e;
+        },
+        [](Extent a, const Extent& b) {
+            a.lo = glm::min(a.lo, b.lo), a.hi = glm::max(a.hi, b.hi);
+            a.area += b.area, a.count += b.count;
+            return a;
+        });
+    if (extent.count == 0) return;
+    plane.origin = extent.lo;
+    plane.size =
+        std::sqrt(extent.area / std::max(static_cast<double>(extent.count) * pixelsPerTriangle,
+                                         SunMap::kLeastPixels));
+    const glm::dvec2 span = extent.hi - extent.lo;
+    for (;;) {
+        plane.width = static_cast<std::int64_t>(std::ceil(span.x / plane.size)) + 1;
+        plane.height = static_cast<std::int64_t>(std::ceil(span.y / plane.size)) + 1;
+        plane.tilesAcross = (plane.width + kTile - 1) / kTile;
+        plane.tilesDown = (plane.height + kTile - 1) / kTile;
+        if (plane.tilesAcross * plane.tilesDown <= kMostTiles) break;
+        plane.size *= 2.0;  // organs spread far and wide: coarser pixels
+    }
+    const std::int64_t tiles = plane.tilesAcross * plane.tilesDown;
+    counts.pixelM = std::max(counts.pixelM, plane.size);
+    // The tiles organs lie in, numbered.
+    std::vector<std::uint8_t> organTile(tiles, 0);
+    tbb::parallel_for(std::uint32_t{0}, organs, [&](std::uint32_t t) {
+        const Drawn d = Draw(scene, plane, t);
+        for (std::int64_t ty = d.y0 / kTile; ty <= d.y1 / kTile && d.y0 <= d.y1; ++ty) {
+            for (std::int64_t tx = d.x0 / kTile; tx <= d.x1 / kTile && d.x0 <= d.x1; ++tx)
+                std::atomic_ref<std::uint8_t>(organTile[ty * plane.tilesAcross + tx])
+                    .store(1, std::memory_order_relaxed);
+        }
+    });
+    std::vector<std::uint32_t> number(tiles, kNoOwner);
+    std::vector<std::int64_t> drawn;  // the tiles drawn, by number
+    for (std::int64_t k = 0; k < tiles; ++k) {
+        if (organTile[k]) number[k] = static_cast<std::uint32_t>(drawn.size()), drawn.push_back(k);
+    }
+    organTile = {};
+    // Every triangle into the drawn tiles its box meets: counted, then listed.
+    std::vector<std::uint32_t> start(drawn.size() + 1, 0);
+    const auto eachTile = [&](const Drawn& d, auto&& visit) {
+        if (d.x0 > d.x1 || d.y0 > d.y1) return;
+        for (std::int64_t ty = d.y0 / kTile; ty <= d.y1 / kTile; ++ty) {
+            for (std::int64_t tx = d.x0 / kTile; tx <= d.x1 / kTile; ++tx) {
+                if (const std::uint32_t k = number[ty * plane.tilesAcross + tx]; k != kNoOwner)
+                    visit(k);
+            }
+        }
+    };
+    tbb::parallel_for(std::uint32_t{0}, triangles, [&](std::uint32_t t) {
+        eachTile(Draw(scene, plane, t), [&](std::uint32_t k) {
+            std::atomic_ref<std::uint32_t>(start[k + 1]).fetch_add(1, std::memory_order_relaxed);
+        });
+    });
+    for (std::size_t k = 0; k < drawn.size(); ++k) start[k + 1] += start[k];
+    std::vector<std::uint32_t> listed(start.back());
+    {
+        std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
+        tbb::parallel_for(std::uint32_t{0}, triangles, [&](std::uint32_t t) {
+            eachTile(Draw(scene, plane, t), [&](std::uint32_t k) {
+                listed[std::atomic_ref<std::uint32_t>(next[k]).fetch_add(
+                    1, std::memory_order_relaxed)] = t;
+            });
+        });
+    }
+    std::atomic<std::int64_t> fragments{0};
+    tbb::parallel_for(std::size_t{0}, drawn.size(), [&](std::size_t k) {
+        const std::int64_t tx0 = drawn[k] % plane.tilesAcross * kTile;
+        const std::int64_t ty0 = drawn[k] / plane.tilesAcross * kTile;
+        // In triangle order, whatever order the threads listed them in.
+        std::sort(listed.begin() + start[k], listed.begin() + start[k + 1]);
+        const std::span<const std::uint32_t> list(listed.data() + start[k],
+                                                  start[k + 1] - start[k]);
+        thread_local std::vector<double> depth;
+        thread_local std::vector<std::uint32_t> owner, covered, lit;
+        depth.assign(kTile * kTile, -std::numeric_limits<double>::infinity());
+        owner.assign(kTile * kTile, kNoOwner);
+        covered.assign(list.size(), 0);
+        lit.assign(list.size(), 0);
+        std::int64_t drawnHere = 0;
+        for (std::size_t i = 0; i < list.size(); ++i) {
+            const Drawn d = Draw(scene, plane, list[i]);
+            const std::int64_t x0 = std::max(d.x0, tx0), x1 = std::min(d.x1, tx0 + kTile - 1);
+            const std::int64_t y0 = std::max(d.y0, ty0), y1 = std::min(d.y1, ty0 + kTile - 1);
+            // Edge k faces corner k: e_k(q) = (p[k+2] − p[k+1]) × (q − p[k+1]), all ≥ 0
+            // inside, summing to area2; the depth is Σ e_k depth_k / area2. A row's pixels
+            // inside are those between the bounds each edge sets.
+            double ex[3], ey[3], e0[3];
+            for (int e = 0; e < 3; ++e) {
+                const glm::dvec2 a = d.p[(e + 1) % 3], b = d.p[(e + 2) % 3];
+                ex[e] = -(b.y - a.y), ey[e] = b.x - a.x;
+                const glm::dvec2 q(x0 + 0.5, y0 + 0.5);
+                e0[e] = (b.x - a.x) * (q.y - a.y) - (b.y - a.y) * (q.x - a.x);
+            }
+            const auto depthAt = [&](const double* e) {
+                return (e[0] * d.depth[0] + e[1] * d.depth[1] + e[2] * d.depth[2]) / d.area2;
+            };
+            const double dzdx = depthAt(ex);
+            const std::int64_t columns = x1 - x0;
+            for (std::int64_t y = y0; y <= y1; ++y) {
+                double e[3];
+                std::int64_t from = 0, to = columns;
+                for (int j = 0; j < 3; ++j) {
+                    e[j] = e0[j] + ey[j] * static_cast<double>(y - y0);
+                    // e_j + ex_j k ≥ 0 for the k-th pixel of the row.
+                    if (ex[j] > 0.0) {
+                        const double first = std::ceil(-e[j] / ex[j]);
+                        if (first > static_cast<double>(from))
+                            from = first > static_cast<double>(columns)
+                                       ? columns + 1
+                                       : static_cast<std::int64_t>(first);
+                    } else if (ex[j] < 0.0) {
+                        const double last = std::floor(e[j] / -ex[j]);
+                        if (last < static_cast<double>(to))
+                            to = last < 0.0 ? -1 : static_cast<std::int64_t>(last);
+                    } else if (e[j] < 0.0) {
+                        to = -1;
+                    }
+                }
+                if (from > to) continue;
+                covered[i] += static_cast<std::uint32_t>(to - from + 1);
+                drawnHere += to - from + 1;
+                double z = depthAt(e) + dzdx * static_cast<double>(from);
+                double* row = depth.data() + (y - ty0) * kTile + (x0 - tx0);
+                std::uint32_t* rowOwner = owner.data() + (y - ty0) * kTile + (x0 - tx0);
+                for (std::int64_t c = from; c <= to; ++c, z += dzdx) {
+                    // Nearest the light; of two as near, the first listed.
+                    if (z > row[c]) row[c] = z, rowOwner[c] = static_cast<std::uint32_t>(i);
+                }
+            }
+        }
+        for (std::uint32_t o : owner) {
+            if (o != kNoOwner) ++lit[o];
+        }
+        for (std::size_t i = 0; i < list.size() && list[i] < organs; ++i) {
+            if (covered[i] == 0) continue;
+            std::atomic_ref<std::uint32_t>(counts.covered[list[i]])
+                .fetch_add(covered[i], std::memory_order_relaxed);
+            std::atomic_ref<std::uint32_t>(counts.lit[list[i]])
+                .fetch_add(lit[i], std::memory_order_relaxed);
+        }
+        fragments += drawnHere;
+    });
+    counts.fragments += fragments;
+}
+
+}  // namespace
+
+SunMaps::SunMaps(const RayScene& rays, const FlatScene& receivers, const std::vector<Sun>& suns) {
+    if (rays.Periodic()) return;
+    std::uint32_t triangles = 0, organs = 0;
+    bool organsFirst = true;
+    for (const Receiver& r : receivers.receivers) {
+        triangles = std::max(triangles, r.firstTriangle + r.triangleCount);
+        organsFirst = organsFirst && r.kind == ReceiverKind::kOrgan;
+        if (organsFirst) organs += r.triangleCount;
+    }
+    if (organs == 0) return;
+    for (const Sun& sun : suns)
+        maps.emplace_back(rays, triangles, organs, sun.toward, sun.cosRadius);
+}
+
+SunMap::SunMap(const RayScene& scene, std::uint32_t triangles, std::uint32_t organTriangles,
+               const glm::dvec3& toward, double cosRadius, double pixelsPerTriangle)
+    : toward_(toward), cosRadius_(cosRadius), lit_(organTriangles, kNone) {
+    LEAFLUX_CHECK(!scene.Periodic());
+    LEAFLUX_CHECK(organTriangles <= triangles);
+    Counts counts{std::vector<std::uint32_t>(organTriangles, 0),
+                  std::vector<std::uint32_t>(organTriangles, 0)};
+    if (cosRadius >= 1.0) {
+        DrawAlong(scene, triangles, organTriangles, toward, pixelsPerTriangle, counts);
+    } else {
+        // Directions even in solid angle over the disc, turning by the golden angle.
+        const Plane around(toward);
+        const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+        for (int k = 0; k < kDiscDirections; ++k) {
+            const double cosTheta = 1.0 - (k + 0.5) / kDiscDirections * (1.0 - cosRadius);
+            const double sinTheta = std::sqrt(std::max(0.0, 1.0 - cosTheta * cosTheta));
+            const double phi = golden * k;
+            const glm::dvec3 w = cosTheta * toward +
+                                 sinTheta * (std::cos(phi) * around.u + std::sin(phi) * around.v);
+            DrawAlong(scene, triangles, organTriangles, glm::normalize(w), pixelsPerTriangle,
+                      counts);
+        }
+    }
+    for (std::uint32_t t = 0; t < organTriangles; ++t) {
+        if (counts.covered[t] == 0) continue;
+        lit_[t] = static_cast<std::uint16_t>(
+            std::lround(static_cast<double>(counts.lit[t]) * kWhole / counts.covered[t]));
+    }
+    fragments_ = counts.fragments;
+    pixelM_ = counts.pixelM;
+}
+
+}  // namespace leaflux

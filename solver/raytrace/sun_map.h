@@ -1,0 +1,78 @@
+// A sun's light on each organ triangle, from the scene's triangles drawn as the sun sees
+// them: an item buffer on a plane across the light, each pixel keeping the triangle
+// nearest the sun there. An organ triangle's lit share is the share of the pixels it
+// covers where it is that nearest triangle — what rays from its points towards the sun
+// find, without their noise, at the cost of drawing every triangle once. The pixel is
+// sized so that the organ triangles cover kPixelsPerTriangle pixels on the mean; only the
+// tiles of the plane where organs lie are drawn, so a wide ground costs no more than its
+// part under them. A sun of some angular radius is drawn from points spread over its disc
+// (kDiscDirections of them), its soft shadows the mean of their hard ones.
+//
+// Read-only once made: read it from any thread.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <vector>
+
+#include "solver/raytrace/raytrace.h"
+
+namespace leaflux {
+
+class SunMap {
+  public:
+    static constexpr double kPixelsPerTriangle = 256.0;
+    static constexpr double kLeastPixels = 1 << 20;  // over all the organs, however few
+    static constexpr int kDiscDirections = 8;
+
+    // Over the scene's first `triangles` triangles (not periodic), of which the first
+    // `organTriangles` are lit; `toward`: unit, towards the sun; `cosRadius`: of its angular
+    // radius (1: a point).
+    SunMap(const RayScene& scene, std::uint32_t triangles, std::uint32_t organTriangles,
+           const glm::dvec3& toward, double cosRadius,
+           double pixelsPerTriangle = kPixelsPerTriangle);
+
+    const glm::dvec3& Toward() const { return toward_; }
+    double CosRadius() const { return cosRadius_; }
+    // The share of organ triangle t's area across the light that the sun reaches; negative
+    // where no pixel of the map falls on t (edge-on, or smaller than a pixel).
+    double Lit(std::uint32_t t) const {
+        return lit_[t] == kNone ? -1.0 : lit_[t] / static_cast<double>(kWhole);
+    }
+    // The pixels drawn, every triangle's in every tile it was drawn in.
+    std::int64_t Fragments() const { return fragments_; }
+    // The side of a pixel (m; the largest of its directions').
+    double PixelM() const { return pixelM_; }
+
+  private:
+    static constexpr std::uint16_t kWhole = 0xFFFE, kNone = 0xFFFF;
+
+    glm::dvec3 toward_;
+    double cosRadius_;
+    std::vector<std::uint16_t> lit_;  // per organ triangle: its lit share × kWhole, or kNone
+    std::int64_t fragments_ = 0;
+    double pixelM_ = 0.0;
+};
+
+// The maps of a scene's suns, found by the direction they were made for.
+struct SunMaps {
+    struct Sun {
+        glm::dvec3 toward;
+        double cosRadius;
+    };
+    // Over the triangles of `rays`, numbered as the receivers of `receivers` number them,
+    // its organs first (Flatten, ReceiversOf); none in a periodic scene.
+    SunMaps(const RayScene& rays, const FlatScene& receivers, const std::vector<Sun>& suns);
+    SunMaps() = default;
+
+    std::vector<SunMap> maps;
+    // The map of a sun towards `toward` of that cone, or null.
+    const SunMap* Of(const glm::dvec3& toward, double cosRadius) const {
+        for (const SunMap& map : maps) {
+            if (map.Toward() == toward && map.CosRadius() == cosRadius) return &map;
+        }
+        return nullptr;
+    }
+};
+
+}  // namespace leaflux
