@@ -9,7 +9,8 @@
 
 namespace leaflux {
 
-Exposure::Exposure(const NodeModel& model, const RayScene& scene, int raysPerDirection)
+Exposure::Exposure(const NodeModel& model, const RayScene& scene, int raysPerDirection,
+                   const std::vector<std::uint8_t>* needed)
     : model_(&model), bins_(model.BinCount()) {
     const Hierarchy& hierarchy = model.Nodes();
     if (raysPerDirection <= 0) return;
@@ -19,7 +20,9 @@ Exposure::Exposure(const NodeModel& model, const RayScene& scene, int raysPerDir
     std::vector<std::uint32_t> clusters;
     for (std::uint32_t n = 0; n < size; ++n) {
         // A cluster held from outside a local problem receives nothing to hand down.
-        if (!hierarchy[n].patch && !model.Planar(n) && !model.Held(n)) clusters.push_back(n);
+        if (!hierarchy[n].patch && !model.Planar(n) && !model.Held(n) &&
+            (needed == nullptr || (*needed)[n]))
+            clusters.push_back(n);
     }
     const DirectionSet& directions = model.Directions();
     const DirectionSet& coarse =
@@ -90,6 +93,39 @@ Exposure::Exposure(const NodeModel& model, const RayScene& scene, int raysPerDir
         traced += local;
     });
     traced_ = traced;
+}
+
+std::vector<std::uint8_t> ExposedClusters(const NodeModel& model,
+                                          const std::vector<std::uint32_t>& preOrder,
+                                          const Links& links, const Gathered& gathered,
+                                          double scattered,
+                                          const std::function<double(std::uint32_t)>& threshold) {
+    const Hierarchy& hierarchy = model.Nodes();
+    std::vector<std::uint8_t> needed(hierarchy.Size(), 0);
+    const int bins = model.BinCount(), channels = model.ChannelSet().Count();
+    // Down the hierarchy, the bins handed down so far (the path's clusters').
+    struct Above {
+        std::uint32_t node;
+        std::vector<double> bins;
+    };
+    std::vector<Above> path;
+    for (std::uint32_t n : preOrder) {
+        const HrcNode& node = hierarchy[n];
+        while (!path.empty() && path.back().node != node.parent) path.pop_back();
+        if (node.patch || model.Planar(n)) continue;
+        std::vector<double> sum =
+            path.empty() ? std::vector<double>(bins * channels, 0.0) : path.back().bins;
+        if (!links.node[n].empty()) {
+            const double* in = gathered.bins[model.Slot(n)];
+            for (int i = 0; i < bins * channels; ++i) sum[i] += in[i];
+        }
+        double power = 0.0;
+        for (int d = 0; d < bins; ++d)
+            power += model.ChannelSet().Measure(&sum[d * channels]) * model.ProjectedBin(n, d);
+        needed[n] = scattered * power > threshold(n);
+        path.push_back({n, std::move(sum)});
+    }
+    return needed;
 }
 
 }  // namespace leaflux

@@ -8,9 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <numbers>
 #include <optional>
 
+#include "solver/radiosity/beams.h"
 #include "solver/radiosity/closed_scattering.h"
 #include "solver/radiosity/estimate.h"
 #include "solver/radiosity/exposure.h"
@@ -34,6 +34,9 @@ namespace {
 // last.
 constexpr int kRefinementPasses = 3;
 constexpr int kSweepsBeforeRerefining = 30;
+// The largest ρ + τ the scattered light's bound takes (ExposureNeeded): 20 times what one
+// gather finds.
+constexpr double kMostAlbedo = 0.95;
 
 // The parts of the solve's progress (HrcOptions::progress) its stages take, from their
 // times at ε = 1e-4 (`SPDLOG_LEVEL=debug leaflux solve --solver hrc`): on the 10k tree
@@ -45,68 +48,6 @@ struct Stage {
 };
 constexpr Stage kExposureStage{0.0, 0.05}, kSourceStage{0.05, 0.2}, kSelfStage{0.2, 0.67},
     kPassesStage{0.67, 0.97}, kOutputsStage{0.97, 1.0};
-
-// The suns and sky cones of a scene as cones of light (links.h), one channel per band;
-// those that bring nothing are left out.
-std::vector<DirectionalSource> BeamsOf(const Scene& scene, SkyDiscretization skyCones) {
-    std::vector<DirectionalSource> sources;
-    const auto add = [&](const glm::dvec3& toward, const std::vector<double>& irradiance,
-                         double cosRadius) {
-        DirectionalSource source{toward, std::vector<double>(scene.bands.size(), 0.0), cosRadius};
-        double total = 0.0;
-        for (std::size_t b = 0; b < scene.bands.size(); ++b)
-            total += source.normalIrradiance[b] = irradiance[b];
-        if (total <= 0.0) return static_cast<DirectionalSource*>(nullptr);
-        return &sources.emplace_back(std::move(source));
-    };
-    for (const Sun& sun : scene.sources.suns) {
-        if (DirectionalSource* added =
-                add(sun.towardSun, sun.normalIrradianceWm2, std::cos(sun.angularRadiusRad)))
-            added->eachOrgan = true;
-    }
-    for (const Sky& sky : scene.sources.skies) {
-        Sky discrete = sky;
-        if (discrete.discretization == SkyDiscretization::kContinuous)
-            discrete.discretization = skyCones;
-        for (const SkyCone& cone : discrete.Cones()) {
-            // A circular cone of the cell's solid angle, as the reference takes it: on a
-            // plane facing its axis it brings L ∫ cos = L Ω (1 + cos r) / 2.
-            const double cosRadius = 1.0 - cone.solidAngleSr / (2.0 * std::numbers::pi);
-            std::vector<double> irradiance;
-            for (double radiance : cone.radianceWm2Sr)
-                irradiance.push_back(radiance * cone.solidAngleSr * (1.0 + cosRadius) / 2.0);
-            if (DirectionalSource* added = add(cone.direction, irradiance, cosRadius))
-                added->FoldAtHorizon();
-        }
-    }
-    return sources;
-}
-
-// Unit parallel beams, one per direction: channels bands × beams, beam k lighting only its
-// own channels, each judged as a scene of its own (kWorstBeam).
-std::vector<DirectionalSource> UnitBeams(const Channels& channels,
-                                         std::span<const glm::dvec3> towardSource) {
-    std::vector<DirectionalSource> sources;
-    for (int beam = 0; beam < channels.beams; ++beam) {
-        DirectionalSource source{glm::normalize(towardSource[beam]),
-                                 std::vector<double>(channels.Count(), 0.0)};
-        for (int b = 0; b < channels.bands; ++b)
-            source.normalIrradiance[beam * channels.bands + b] = 1.0;
-        sources.push_back(std::move(source));
-    }
-    return sources;
-}
-
-// The maps of a whole scene's suns, for the links into its organs (eachOrgan): none in a
-// scene with closed instances, whose transmittance no map holds.
-SunMaps DrawSuns(const FlatScene& flat, const RayScene& rays,
-                 std::span<const DirectionalSource> sources) {
-    std::vector<SunMaps::Sun> suns;
-    for (const DirectionalSource& source : sources) {
-        if (source.eachOrgan && source.beyond) suns.push_back({source.toward, source.cosRadius});
-    }
-    return suns.empty() ? SunMaps{} : SunMaps(rays, flat, suns);
-}
 
 class SceneSolve {
   public:
@@ -141,6 +82,7 @@ class SceneSolve {
                                         : std::make_unique<Occlusion>(rays, ProxiesOf(closed))),
           occlusion_(level.occlusion ? *level.occlusion : *ownOcclusion_),
           level_(level),
+          // The whole scene's maps; none with closed instances, whose τ no map holds.
           sunMaps_(level.occlusion || !closed.empty() ? SunMaps{} : DrawSuns(flat, rays, sources_)),
           estimator_(model_, field_),
           visibility_(model_, field_, occlusion_, options.visibilityRays, options.sourceRays,
@@ -224,6 +166,11 @@ class SceneSolve {
     // hold, the light scattered onto their organ there (WarmStart::Apply). Returns how
     // many organs it had.
     std::int64_t WarmLeaves();
+    // After refinement, the clusters whose children take their share of the light they hand
+    // down by exposure: those that hand down more than a link into them may carry
+    // (Refiner::Threshold), as one gather from the direct light's radiosity finds it, times
+    // 1 / (1 − a) for the light scattered on, a the largest ρ + τ of the scene's optics.
+    std::vector<std::uint8_t> ExposureNeeded();
     // Jacobi from the emission, then refine–solve passes until no link needs refining.
     void Iterate(Refiner& refiner, Solution& solution, Stopwatch& clock);
     // At the scene's top, on the first arrival (the lamps' light: the suns' and sky's reach
@@ -368,7 +315,6 @@ void SceneSolve::OnSplit(std::uint32_t n) {
 void SceneSolve::Solve(Solution& solution) {
     activeRoot_ = hierarchy_.Root();
     Index();
-    exposure_ = Exposure(model_, rays_, options_.exposureRays);
     Report(kExposureStage, 1.0);
     const auto& preOrder = traversal_.PreOrder();
     for (std::uint32_t n : preOrder)
@@ -426,6 +372,10 @@ void SceneSolve::Solve(Solution& solution) {
         refiner.Refine({{Task::kSelf, hierarchy_.Root(), hierarchy_.Root()}});
     Report(kSelfStage, 1.0);
     Index();
+    if (options_.exposureRays > 0) {
+        const std::vector<std::uint8_t> needed = ExposureNeeded();
+        exposure_ = Exposure(model_, rays_, options_.exposureRays, &needed);
+    }
     const double refineSeconds = clock.Lap();
     const std::int64_t refineRays = rays() - sourceRays;
 
@@ -442,6 +392,21 @@ void SceneSolve::Solve(Solution& solution) {
         "passes), outputs {:.3f} s ({} rays)",
         sourceSeconds, sourceRays, refineSeconds, refineRays, passRays, clock.Lap(),
         rays() - sourceRays - refineRays - passRays);
+}
+
+std::vector<std::uint8_t> SceneSolve::ExposureNeeded() {
+    double albedo = 0.0;
+    for (const Optics& optics : scene_.optics) {
+        for (const BandOptics& b : optics.bands)
+            albedo =
+                std::max({albedo, b.rhoUpper + b.tauUpperToLower, b.rhoLower + b.tauLowerToUpper});
+    }
+    Gather<false>(model_, field_, *active_, traversal_.Receivers(), gathered_);
+    return ExposedClusters(model_, traversal_.PreOrder(), *active_, gathered_,
+                           1.0 / (1.0 - std::min(albedo, kMostAlbedo)), [&](std::uint32_t n) {
+                               return model_.Importance(n) * thresholds_.errorW *
+                                      thresholds_.clusterTolerance;
+                           });
 }
 
 std::int64_t SceneSolve::WarmLeaves() {
