@@ -372,7 +372,10 @@ void SceneSolve::Solve(Solution& solution) {
         refiner.Refine({{Task::kSelf, hierarchy_.Root(), hierarchy_.Root()}});
     Report(kSelfStage, 1.0);
     Index();
-    if (options_.exposureRays > 0) {
+    // Under unit beams (a phase function, stored for reuse), every cluster takes it.
+    if (channels_.measure == ChannelMeasure::kWorstBeam) {
+        exposure_ = Exposure(model_, rays_, options_.exposureRays);
+    } else if (options_.exposureRays > 0) {
         const std::vector<std::uint8_t> needed = ExposureNeeded();
         exposure_ = Exposure(model_, rays_, options_.exposureRays, &needed);
     }
