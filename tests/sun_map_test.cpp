@@ -87,12 +87,16 @@ TEST(SunMap, TheOrgansStopTheLightTheirShadowLacks) {
     const glm::dvec3 toward = glm::normalize(glm::dvec3(0.3, -0.5, 0.8));
     const auto count = static_cast<std::uint32_t>(flat.triangles.size());
     const SunMap map(rays, count, count, toward, 1.0);
+    // Crossing leaves share the pixels along the lines they cross in (Tied): few.
     double stopped = 0.0;
+    int tied = 0;
     for (std::uint32_t t = 0; t < count; ++t) {
         const Triangle& triangle = flat.triangles[t];
         ASSERT_GE(map.Lit(t), 0.0);
         stopped += map.Lit(t) * triangle.areaM2 * std::abs(glm::dot(triangle.normal, toward));
+        tied += map.Tied(t) ? 1 : 0;
     }
+    EXPECT_LT(tied, static_cast<int>(count) / 4);
     // A square across the light, 3 m below the box along it, wide enough for its shadow.
     const glm::dvec3 u = glm::normalize(glm::cross(glm::dvec3(0, 0, 1), toward));
     const glm::dvec3 v = glm::cross(toward, u);

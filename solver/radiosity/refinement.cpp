@@ -14,10 +14,10 @@ namespace leaflux {
 namespace {
 // The most rounds of a source's rays a closed instance's link from it takes (16 × 64 rays).
 constexpr int kClosedRounds = 16;
-// The rounds of a sun's rays its link into one organ takes (DirectionalSource::eachOrgan).
-// On the 119k-triangle tree at ε = 1e-3, one round (57 rays) left PAR 1.53 % L2 of the
-// reference's maximum, NIR 2.09 %, two 1.34 and 1.98 % for 9 % more time, three 1.28 and
-// 1.95 % for 20 % more.
+// The rounds of a sun's rays its link into one organ takes (DirectionalSource::eachOrgan)
+// where the sun has no map (SunMap). On the 119k-triangle tree at ε = 1e-3, one round
+// (57 rays) left PAR 1.53 % L2 of the reference's maximum, NIR 2.09 %, two 1.34 and 1.98 %
+// for 9 % more time, three 1.28 and 1.95 % for 20 % more.
 constexpr int kOrganRounds = 2;
 }  // namespace
 
@@ -146,8 +146,6 @@ Refiner::Verdict Refiner::JudgeSource(std::uint32_t r, std::uint32_t s) const {
     // any ray is traced.
     if (source.eachOrgan && model_.Shared(r) && !model_.OneOrgan(r) && CanSplit(r))
         return Verdict::Of(Verdict::kSplitReceiver);
-    // The spread is least when every ray agrees: beyond ε even then, no ray can save
-    // the link, and none is traced.
     const double threshold = SourceThreshold(r);
     // Into an organ, with the sun's map: its lit share, found without rays. Handed evenly
     // over the organ, it is off where the organ is partly lit, by as much as rays that
@@ -165,6 +163,8 @@ Refiner::Verdict Refiner::JudgeSource(std::uint32_t r, std::uint32_t s) const {
             return verdict;
         }
     }
+    // The spread is least when every ray agrees: beyond ε even then, no ray can save
+    // the link, and none is traced.
     if (unoccluded * VisibilitySpread(1.0, visibility_.SourceRays(s)) > threshold && CanSplit(r))
         return Verdict::Of(Verdict::kSplitReceiver);
     // Into one organ, such a source's link is all of its light the organ gets, and its

@@ -15,9 +15,9 @@
 namespace leaflux {
 namespace {
 
-constexpr int kTile = 128;                       // pixels a side of a tile
-constexpr std::int64_t kMostTiles = 1 << 22;     // of the plane over the organs
-constexpr std::uint32_t kNoOwner = 0xFFFFFFFFu;  // a pixel no triangle covers
+constexpr int kTile = 128;                      // pixels a side of a tile
+constexpr std::int64_t kMostTiles = 1 << 22;    // of the plane over the organs
+constexpr std::uint32_t kNoTile = 0xFFFFFFFFu;  // a tile no organ lies in
 
 // The plane across a direction of light: pixel (i, j) has its centre at
 // origin + size (i + ½, j + ½) along u and v; depth grows towards the light.
@@ -76,9 +76,56 @@ Drawn Draw(const RayScene& scene, const Plane& plane, std::uint32_t t) {
     return d;
 }
 
+// Visits the rows of the pixels of tile (tx0, ty0) whose centres triangle d covers:
+// visit(at, n, z, dz), the row's first pixel at index `at` of the tile, n pixels, depth z
+// at the first and dz from one to the next. Edge k faces corner k: e_k(q) = (p[k+2] −
+// p[k+1]) × (q − p[k+1]), all ≥ 0 inside, summing to area2; the depth is Σ e_k depth_k /
+// area2. A row's pixels inside are those between the bounds each edge sets.
+template <class Visit>
+void EachSpan(const Drawn& d, std::int64_t tx0, std::int64_t ty0, int tile, Visit visit) {
+    const std::int64_t x0 = std::max(d.x0, tx0), x1 = std::min(d.x1, tx0 + tile - 1);
+    const std::int64_t y0 = std::max(d.y0, ty0), y1 = std::min(d.y1, ty0 + tile - 1);
+    double ex[3], ey[3], e0[3];
+    for (int e = 0; e < 3; ++e) {
+        const glm::dvec2 a = d.p[(e + 1) % 3], b = d.p[(e + 2) % 3];
+        ex[e] = -(b.y - a.y), ey[e] = b.x - a.x;
+        const glm::dvec2 q(x0 + 0.5, y0 + 0.5);
+        e0[e] = (b.x - a.x) * (q.y - a.y) - (b.y - a.y) * (q.x - a.x);
+    }
+    const auto depthAt = [&](const double* e) {
+        return (e[0] * d.depth[0] + e[1] * d.depth[1] + e[2] * d.depth[2]) / d.area2;
+    };
+    const double dzdx = depthAt(ex);
+    const std::int64_t columns = x1 - x0;
+    for (std::int64_t y = y0; y <= y1; ++y) {
+        double e[3];
+        std::int64_t from = 0, to = columns;
+        for (int j = 0; j < 3; ++j) {
+            e[j] = e0[j] + ey[j] * static_cast<double>(y - y0);
+            // e_j + ex_j k ≥ 0 for the k-th pixel of the row.
+            if (ex[j] > 0.0) {
+                const double first = std::ceil(-e[j] / ex[j]);
+                if (first > static_cast<double>(from))
+                    from = first > static_cast<double>(columns) ? columns + 1
+                                                                : static_cast<std::int64_t>(first);
+            } else if (ex[j] < 0.0) {
+                const double last = std::floor(e[j] / -ex[j]);
+                if (last < static_cast<double>(to))
+                    to = last < 0.0 ? -1 : static_cast<std::int64_t>(last);
+            } else if (e[j] < 0.0) {
+                to = -1;
+            }
+        }
+        if (from > to) continue;
+        visit(static_cast<std::size_t>((y - ty0) * tile + (x0 - tx0) + from), to - from + 1,
+              depthAt(e) + dzdx * static_cast<double>(from), dzdx);
+    }
+}
+
 // The pixel counts of the organ triangles under one direction of light.
 struct Counts {
     std::vector<std::uint32_t> covered, lit;
+    std::vector<std::uint8_t> tied;  // another triangle as near in a pixel of it
     std::int64_t fragments = 0;
     double pixelM = 0.0;
 };
@@ -131,6 +178,11 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
         plane.size *= 2.0;  // organs spread far and wide: coarser pixels
     }
     const std::int64_t tiles = plane.tilesAcross * plane.tilesDown;
+    // Depths this close are one plane's: the corners' single precision, 2⁻²¹ of the
+    // scene's largest coordinate (and of 1 m), under a micrometre for a plant.
+    const FlatScene& frame = scene.Flat();
+    const double coplanar = std::ldexp(
+        std::max({1.0, glm::length(frame.boundsMin), glm::length(frame.boundsMax)}), -21);
     counts.pixelM = std::max(counts.pixelM, plane.size);
     // The tiles organs lie in, numbered.
     std::vector<std::uint8_t> organTile(tiles, 0);
@@ -142,7 +194,7 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
                     .store(1, std::memory_order_relaxed);
         }
     });
-    std::vector<std::uint32_t> number(tiles, kNoOwner);
+    std::vector<std::uint32_t> number(tiles, kNoTile);
     std::vector<std::int64_t> drawn;  // the tiles drawn, by number
     for (std::int64_t k = 0; k < tiles; ++k) {
         if (organTile[k]) number[k] = static_cast<std::uint32_t>(drawn.size()), drawn.push_back(k);
@@ -154,7 +206,7 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
         if (d.x0 > d.x1 || d.y0 > d.y1) return;
         for (std::int64_t ty = d.y0 / kTile; ty <= d.y1 / kTile; ++ty) {
             for (std::int64_t tx = d.x0 / kTile; tx <= d.x1 / kTile; ++tx) {
-                if (const std::uint32_t k = number[ty * plane.tilesAcross + tx]; k != kNoOwner)
+                if (const std::uint32_t k = number[ty * plane.tilesAcross + tx]; k != kNoTile)
                     visit(k);
             }
         }
@@ -184,72 +236,41 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
         const std::span<const std::uint32_t> list(listed.data() + start[k],
                                                   start[k + 1] - start[k]);
         thread_local std::vector<double> depth;
-        thread_local std::vector<std::uint32_t> owner, covered, lit;
+        thread_local std::vector<std::uint32_t> covered, lit, tied;
         depth.assign(kTile * kTile, -std::numeric_limits<double>::infinity());
-        owner.assign(kTile * kTile, kNoOwner);
         covered.assign(list.size(), 0);
         lit.assign(list.size(), 0);
+        tied.assign(list.size(), 0);
         std::int64_t drawnHere = 0;
+        // The depth nearest the light at each pixel, then the organ triangles' pixels that
+        // are within `coplanar` of it: two triangles in one plane do not shade each other,
+        // as a ray from a point of one passes the other.
         for (std::size_t i = 0; i < list.size(); ++i) {
-            const Drawn d = Draw(scene, plane, list[i]);
-            const std::int64_t x0 = std::max(d.x0, tx0), x1 = std::min(d.x1, tx0 + kTile - 1);
-            const std::int64_t y0 = std::max(d.y0, ty0), y1 = std::min(d.y1, ty0 + kTile - 1);
-            // Edge k faces corner k: e_k(q) = (p[k+2] − p[k+1]) × (q − p[k+1]), all ≥ 0
-            // inside, summing to area2; the depth is Σ e_k depth_k / area2. A row's pixels
-            // inside are those between the bounds each edge sets.
-            double ex[3], ey[3], e0[3];
-            for (int e = 0; e < 3; ++e) {
-                const glm::dvec2 a = d.p[(e + 1) % 3], b = d.p[(e + 2) % 3];
-                ex[e] = -(b.y - a.y), ey[e] = b.x - a.x;
-                const glm::dvec2 q(x0 + 0.5, y0 + 0.5);
-                e0[e] = (b.x - a.x) * (q.y - a.y) - (b.y - a.y) * (q.x - a.x);
-            }
-            const auto depthAt = [&](const double* e) {
-                return (e[0] * d.depth[0] + e[1] * d.depth[1] + e[2] * d.depth[2]) / d.area2;
-            };
-            const double dzdx = depthAt(ex);
-            const std::int64_t columns = x1 - x0;
-            for (std::int64_t y = y0; y <= y1; ++y) {
-                double e[3];
-                std::int64_t from = 0, to = columns;
-                for (int j = 0; j < 3; ++j) {
-                    e[j] = e0[j] + ey[j] * static_cast<double>(y - y0);
-                    // e_j + ex_j k ≥ 0 for the k-th pixel of the row.
-                    if (ex[j] > 0.0) {
-                        const double first = std::ceil(-e[j] / ex[j]);
-                        if (first > static_cast<double>(from))
-                            from = first > static_cast<double>(columns)
-                                       ? columns + 1
-                                       : static_cast<std::int64_t>(first);
-                    } else if (ex[j] < 0.0) {
-                        const double last = std::floor(e[j] / -ex[j]);
-                        if (last < static_cast<double>(to))
-                            to = last < 0.0 ? -1 : static_cast<std::int64_t>(last);
-                    } else if (e[j] < 0.0) {
-                        to = -1;
-                    }
-                }
-                if (from > to) continue;
-                covered[i] += static_cast<std::uint32_t>(to - from + 1);
-                drawnHere += to - from + 1;
-                double z = depthAt(e) + dzdx * static_cast<double>(from);
-                double* row = depth.data() + (y - ty0) * kTile + (x0 - tx0);
-                std::uint32_t* rowOwner = owner.data() + (y - ty0) * kTile + (x0 - tx0);
-                for (std::int64_t c = from; c <= to; ++c, z += dzdx) {
-                    // Nearest the light; of two as near, the first listed.
-                    if (z > row[c]) row[c] = z, rowOwner[c] = static_cast<std::uint32_t>(i);
-                }
-            }
-        }
-        for (std::uint32_t o : owner) {
-            if (o != kNoOwner) ++lit[o];
+            EachSpan(Draw(scene, plane, list[i]), tx0, ty0, kTile,
+                     [&](std::size_t at, std::int64_t n, double z, double dz) {
+                         covered[i] += static_cast<std::uint32_t>(n);
+                         drawnHere += n;
+                         for (std::int64_t c = 0; c < n; ++c, z += dz)
+                             depth[at + c] = std::max(depth[at + c], z);
+                     });
         }
         for (std::size_t i = 0; i < list.size() && list[i] < organs; ++i) {
             if (covered[i] == 0) continue;
+            EachSpan(Draw(scene, plane, list[i]), tx0, ty0, kTile,
+                     [&](std::size_t at, std::int64_t n, double z, double dz) {
+                         for (std::int64_t c = 0; c < n; ++c, z += dz) {
+                             if (z < depth[at + c] - coplanar) continue;
+                             ++lit[i];
+                             tied[i] += z < depth[at + c] ? 1 : 0;
+                         }
+                     });
             std::atomic_ref<std::uint32_t>(counts.covered[list[i]])
                 .fetch_add(covered[i], std::memory_order_relaxed);
             std::atomic_ref<std::uint32_t>(counts.lit[list[i]])
                 .fetch_add(lit[i], std::memory_order_relaxed);
+            if (tied[i] > 0)
+                std::atomic_ref<std::uint8_t>(counts.tied[list[i]])
+                    .store(1, std::memory_order_relaxed);
         }
         fragments += drawnHere;
     });
@@ -278,7 +299,8 @@ SunMap::SunMap(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
     LEAFLUX_CHECK(!scene.Periodic());
     LEAFLUX_CHECK(organTriangles <= triangles);
     Counts counts{std::vector<std::uint32_t>(organTriangles, 0),
-                  std::vector<std::uint32_t>(organTriangles, 0)};
+                  std::vector<std::uint32_t>(organTriangles, 0),
+                  std::vector<std::uint8_t>(organTriangles, 0)};
     if (cosRadius >= 1.0) {
         DrawAlong(scene, triangles, organTriangles, toward, pixelsPerTriangle, counts);
     } else {
@@ -300,6 +322,7 @@ SunMap::SunMap(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
         lit_[t] = static_cast<std::uint16_t>(
             std::lround(static_cast<double>(counts.lit[t]) * kWhole / counts.covered[t]));
     }
+    tied_ = std::move(counts.tied);
     fragments_ = counts.fragments;
     pixelM_ = counts.pixelM;
 }

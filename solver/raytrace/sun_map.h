@@ -39,6 +39,11 @@ class SunMap {
     double Lit(std::uint32_t t) const {
         return lit_[t] == kNone ? -1.0 : lit_[t] / static_cast<double>(kWhole);
     }
+    // Whether another triangle lies in t's plane, as near the sun, over a pixel of t (the
+    // same triangle twice, two crossing in a line): which of the two a ray from a point
+    // there meets, or a path of the reference's, is left to rounding, and the map cannot
+    // say. Such an organ takes rays.
+    bool Tied(std::uint32_t t) const { return tied_[t] != 0; }
     // The pixels drawn, every triangle's in every tile it was drawn in.
     std::int64_t Fragments() const { return fragments_; }
     // The side of a pixel (m; the largest of its directions').
@@ -50,6 +55,7 @@ class SunMap {
     glm::dvec3 toward_;
     double cosRadius_;
     std::vector<std::uint16_t> lit_;  // per organ triangle: its lit share × kWhole, or kNone
+    std::vector<std::uint8_t> tied_;  // per organ triangle: Tied
     std::int64_t fragments_ = 0;
     double pixelM_ = 0.0;
 };
