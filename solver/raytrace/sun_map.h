@@ -1,8 +1,9 @@
 // A sun's light on each organ triangle, from the scene's triangles drawn as the sun sees
-// them: an item buffer on a plane across the light, each pixel keeping the triangle
-// nearest the sun there. An organ triangle's lit share is the share of the pixels it
-// covers where it is that nearest triangle — what rays from its points towards the sun
-// find, without their noise, at the cost of drawing every triangle once. The pixel is
+// them: a depth buffer on a plane across the light, each pixel keeping the depth nearest
+// the sun there. An organ triangle's lit share is the share of the pixels it covers where
+// it is that near (to the corners' precision: a triangle in its plane does not shade it)
+// — what rays from its points towards the sun find, without their noise, at the cost of
+// drawing every triangle once and the organs' twice. The pixel is
 // sized so that the organ triangles cover kPixelsPerTriangle pixels on the mean; only the
 // tiles of the plane where organs lie are drawn, so a wide ground costs no more than its
 // part under them. A sun of some angular radius is drawn from points spread over its disc
