@@ -126,7 +126,6 @@ void EachSpan(const Drawn& d, std::int64_t tx0, std::int64_t ty0, int tile, Visi
 struct Counts {
     std::vector<std::uint32_t> covered, lit;
     std::vector<std::uint8_t> tied;  // another triangle as near in a pixel of it
-    std::int64_t fragments = 0;
     double pixelM = 0.0;
 };
 
@@ -227,7 +226,6 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
             });
         });
     }
-    std::atomic<std::int64_t> fragments{0};
     tbb::parallel_for(std::size_t{0}, drawn.size(), [&](std::size_t k) {
         const std::int64_t tx0 = drawn[k] % plane.tilesAcross * kTile;
         const std::int64_t ty0 = drawn[k] / plane.tilesAcross * kTile;
@@ -241,7 +239,6 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
         covered.assign(list.size(), 0);
         lit.assign(list.size(), 0);
         tied.assign(list.size(), 0);
-        std::int64_t drawnHere = 0;
         // The depth nearest the light at each pixel, then the organ triangles' pixels that
         // are within `coplanar` of it: two triangles in one plane do not shade each other,
         // as a ray from a point of one passes the other.
@@ -249,7 +246,6 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
             EachSpan(Draw(scene, plane, list[i]), tx0, ty0, kTile,
                      [&](std::size_t at, std::int64_t n, double z, double dz) {
                          covered[i] += static_cast<std::uint32_t>(n);
-                         drawnHere += n;
                          for (std::int64_t c = 0; c < n; ++c, z += dz)
                              depth[at + c] = std::max(depth[at + c], z);
                      });
@@ -272,9 +268,7 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
                 std::atomic_ref<std::uint8_t>(counts.tied[list[i]])
                     .store(1, std::memory_order_relaxed);
         }
-        fragments += drawnHere;
     });
-    counts.fragments += fragments;
 }
 
 }  // namespace
@@ -323,7 +317,6 @@ SunMap::SunMap(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
             std::lround(static_cast<double>(counts.lit[t]) * kWhole / counts.covered[t]));
     }
     tied_ = std::move(counts.tied);
-    fragments_ = counts.fragments;
     pixelM_ = counts.pixelM;
 }
 

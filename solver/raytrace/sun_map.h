@@ -45,8 +45,6 @@ class SunMap {
     // there meets, or a path of the reference's, is left to rounding, and the map cannot
     // say. Such an organ takes rays.
     bool Tied(std::uint32_t t) const { return tied_[t] != 0; }
-    // The pixels drawn, every triangle's in every tile it was drawn in.
-    std::int64_t Fragments() const { return fragments_; }
     // The side of a pixel (m; the largest of its directions').
     double PixelM() const { return pixelM_; }
 
@@ -57,7 +55,6 @@ class SunMap {
     double cosRadius_;
     std::vector<std::uint16_t> lit_;  // per organ triangle: its lit share × kWhole, or kNone
     std::vector<std::uint8_t> tied_;  // per organ triangle: Tied
-    std::int64_t fragments_ = 0;
     double pixelM_ = 0.0;
 };
 
