@@ -17,6 +17,7 @@
 #include "solver/instancing/push_down.h"
 #include "solver/instancing/scene_originals.h"
 #include "solver/instancing/signature.h"
+#include "solver/radiosity/beams.h"
 #include "solver/raytrace/occlusion.h"
 #include "solver/scene/geometry.h"
 #include "solver/scene/subtrees.h"
@@ -178,12 +179,9 @@ class InstancedSolve {
     }
     ShadowView ShadowsOf(std::uint32_t p, const FlatScene& flat) const;
     // A map of each sun over the whole scene's triangles (SunMap): the light of the suns on
-    // every organ, found once for all the levels.
+    // every organ, found once for all the levels, for the sources the levels take.
     void DrawSuns() {
-        std::vector<SunMaps::Sun> suns;
-        for (const Sun& sun : scene_.sources.suns)
-            suns.push_back({sun.towardSun, std::cos(sun.angularRadiusRad)});
-        sunMaps_ = SunMaps(*shadows_, receivers_, suns);
+        sunMaps_ = leaflux::DrawSuns(receivers_, *shadows_, BeamsOf(scene_, options_.hrc.skyCones));
     }
     // The light that arrived on closed instance c of `level`, as the sources of its contents.
     std::vector<DirectionalSource> ArrivedOn(const LevelSolution& light, std::size_t c) const;
