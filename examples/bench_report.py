@@ -116,8 +116,8 @@ def error_section(build, out, name, run=True):
     per = " / ".join(dict.fromkeys(r["band"] for r in rows))
     table = [f"### {name}", "", f"{description[0].upper()}{description[1:]}; {int(rows[0]['leaves']):,} leaves.", "",
              f"![{name}]({figure(RESULTS, f'error_{name}.png')})", "",
-             f"| solver | setting | wall s | cpu s | peak MiB | L2 % of max, {per} | mean rel. %, {per} | "
-             f"p95 rel. %, {per} | balance %, {per} |", "|---|---|---|---|---|---|---|---|---|"]
+             f"| solver | setting | wall s | cpu s | peak MiB | working MiB | L2 % of max, {per} | "
+             f"mean rel. %, {per} | p95 rel. %, {per} | balance %, {per} |", "|---|---|---|---|---|---|---|---|---|---|"]
     for key in dict.fromkeys((r["solver"], r["setting"]) for r in rows):
         by_band = [r for r in rows if (r["solver"], r["setting"]) == key]
         first = by_band[0]
@@ -127,7 +127,8 @@ def error_section(build, out, name, run=True):
         else:
             errors = f"{joined('l2_pct_of_max')} | {joined('mean_rel_pct')} | {joined('p95_rel_pct')}"
         table.append(f"| {key[0]} | {key[1]} | {number(first['wall_s'])} | {number(first['cpu_s'])} | "
-                     f"{number(first['peak_mib'])} | {errors} | {joined('balance_residual_pct')} |")
+                     f"{number(first['peak_mib'])} | {number(first['working_mib']) if first.get('working_mib') else '–'} | "
+                     f"{errors} | {joined('balance_residual_pct')} |")
     return "\n".join(table)
 
 

@@ -17,7 +17,7 @@ def daemon_section(build, out, run=True):
     coarsest = daemon_coarsest()
     growths = sorted({(leaves, e) for (leaves, _), e in coarsest.items()}, key=lambda g: (g[0], float(g[1])))
     rows = bench_rows(build, out, "leaflux_bench_daemon", "daemon_bench.csv", run,
-                      [f"{leaves}:{e}" for leaves, e in growths])
+                      [f"--merge-triangles={DAEMON_MERGE}", *(f"{leaves}:{e}" for leaves, e in growths)])
     names = {"growing_tree": "HRC", "growing_tree_warm_start": "HRC, warm start",
              "instanced_cold": "instanced, empty database",
              "instanced_warm": "instanced, the database filled",
@@ -98,7 +98,10 @@ DAEMON_TREES = [("tree1k_bare", 1000), ("tree10k_bare", 10000)]
 DAEMON_EPSILONS = ["1e-4", "2e-4", "3e-4", "5e-4", "7e-4", "1e-3", "2e-3", "3e-3", "5e-3", "7e-3", "1e-2", "2e-2",
                    "5e-2", "1e-1"]
 DAEMON_GOAL_PCT = 2.0  # the L2 error a cycle is asked to stay within, per band
-DAEMON_MERGE = 4096  # leaflux_bench_daemon's kMergeTriangles: the "merged" sessions' bound
+# The merge bound of the "merged" sessions (leaflux_bench_daemon --merge-triangles): the
+# generated trees' branches, of 2,720 triangles on the 10,000-leaf plant, each solved as one
+# problem with its twigs.
+DAEMON_MERGE = 4096
 # The daemon's sessions by solver, as `leaflux bench error` names the same solves: label,
 # solver and what follows the ε in the run's setting.
 DAEMON_SOLVERS = {"HRC": ("hrc", []), "instanced": ("instanced", []),

@@ -285,6 +285,14 @@ struct Row {
     double balancePct = 0.0;
 };
 
+// The solver's working memory (its peak less the memory before it), or -1 where the kernel
+// did not let the peak be reset (and for the reference, measured once in its own run).
+std::int64_t WorkingBytes(const SolveStats& stats) {
+    return stats.solvingPeakRssBytes > 0
+               ? std::max<std::int64_t>(stats.solvingPeakRssBytes - stats.loadedRssBytes, 0)
+               : -1;
+}
+
 void WriteCsv(const std::string& path, const std::string& scene, int leaves,
               const std::vector<Row>& rows) {
     if (std::filesystem::path(path).has_parent_path()) {
@@ -292,13 +300,17 @@ void WriteCsv(const std::string& path, const std::string& scene, int leaves,
     }
     std::ofstream out(path);
     if (!out) throw InputError(ErrorCode::kIo, path, "cannot write");
-    out << "scene,leaves,solver,setting,band,wall_s,cpu_s,peak_mib,iterations,links,"
+    out << "scene,leaves,solver,setting,band,wall_s,cpu_s,peak_mib,working_mib,iterations,links,"
            "l2_pct_of_max,mean_rel_pct,p95_rel_pct,reference_floor_pct,lit_leaves,"
            "balance_residual_pct\n";
     for (const Row& r : rows) {
         out << scene << ',' << leaves << ',' << r.solver << ',' << r.setting << ',' << r.band << ','
             << Number(r.stats.wallSeconds) << ',' << Number(r.stats.cpuSeconds) << ','
             << Number(static_cast<double>(r.stats.peakRssBytes) / (1 << 20)) << ','
+            << (WorkingBytes(r.stats) >= 0
+                    ? Number(static_cast<double>(WorkingBytes(r.stats)) / (1 << 20))
+                    : std::string())
+            << ','
             << r.stats.iterations << ',' << r.stats.links << ',' << Number(r.accuracy.l2PctOfMax)
             << ',' << Number(r.accuracy.meanRelativePct) << ',' << Number(r.accuracy.p95RelativePct)
             << ',' << Number(r.accuracy.referenceFloorPct) << ',' << r.accuracy.litLeaves << ','
@@ -308,14 +320,17 @@ void WriteCsv(const std::string& path, const std::string& scene, int leaves,
 }
 
 void PrintTable(const std::string& scene, const std::vector<Row>& rows) {
-    std::printf("%-12s %-6s %-16s %-5s %8s %8s %9s %8s %9s %8s %8s %9s\n", "scene", "solver",
-                "setting", "band", "wall_s", "cpu_s", "peak_MiB", "L2_%max", "mean_rel%",
-                "p95_rel%", "floor_%", "balance%");
+    std::printf("%-12s %-6s %-16s %-5s %8s %8s %9s %11s %8s %9s %8s %8s %9s\n", "scene",
+                "solver", "setting", "band", "wall_s", "cpu_s", "peak_MiB", "working_MiB",
+                "L2_%max", "mean_rel%", "p95_rel%", "floor_%", "balance%");
     for (const Row& r : rows) {
-        std::printf("%-12s %-6s %-16s %-5s %8.3f %8.3f %9.0f %8.3f %9.3f %8.3f %8.3f %9.3f\n",
+        const std::int64_t working = WorkingBytes(r.stats);
+        std::printf("%-12s %-6s %-16s %-5s %8.3f %8.3f %9.0f %11s %8.3f %9.3f %8.3f %8.3f %9.3f\n",
                     scene.c_str(), r.solver.c_str(), r.setting.c_str(), r.band.c_str(),
                     r.stats.wallSeconds, r.stats.cpuSeconds,
-                    static_cast<double>(r.stats.peakRssBytes) / (1 << 20), r.accuracy.l2PctOfMax,
+                    static_cast<double>(r.stats.peakRssBytes) / (1 << 20),
+                    working >= 0 ? std::to_string(working >> 20).c_str() : "-",
+                    r.accuracy.l2PctOfMax,
                     r.accuracy.meanRelativePct, r.accuracy.p95RelativePct,
                     r.accuracy.referenceFloorPct, r.balancePct);
     }
@@ -449,12 +464,19 @@ int RunErrorBench(const ErrorBenchOptions& options) {
         for (Row& row : rows) row.balancePct = std::nan("");
     PhaseDatabase originals(PhaseDatabaseOptions{});  // the instanced runs'
     for (Run run : Runs(options)) {
-        ResetPeakRss();
+        // The solver's working memory: its peak less what the process held before it (the
+        // scene, the reference, the phase functions the earlier runs put in memory).
+        const bool peakReset = ResetPeakRss();
+        const std::int64_t before = ResidentBytes();
         run.settings.instanced.database = &originals;
         const std::string label = run.solver + " " + run.setting;
         if (run.solver == "hrc") run.settings.hrc.progress = ProgressBar(label);
         if (run.solver == "mc") run.settings.monteCarlo.progress = ProgressBar(label);
-        const Solution solution = Solve(prepared, run.settings);
+        Solution solution = Solve(prepared, run.settings);
+        if (peakReset) {
+            solution.stats.loadedRssBytes = before;
+            solution.stats.solvingPeakRssBytes = solution.stats.peakRssBytes;
+        }
         spdlog::info("{} {}: {:.2f} s", run.solver, run.setting, solution.stats.wallSeconds);
         for (Row& row : RowsOf(run, scene, flat, *reference, solution, within)) rows.push_back(row);
     }

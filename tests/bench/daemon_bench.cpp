@@ -6,11 +6,12 @@
 // last cycle's light (SolverSettings.warm_start); and the same plants with the instanced
 // solver, first on a new daemon's empty phase-function database (cold: the functions
 // computed as the plant's structures appear), then as a second session on the database the
-// first filled (warm: none computed), then a third on it with the warm start, and a fourth
-// with its small instances merged into the problems of those holding them.
-// Run: build/release/tests/leaflux_bench_daemon [out.csv [LEAVES:EPSILON ...]]
-// (default out/bench/daemon_bench.csv); each LEAVES:EPSILON grows one more tree of LEAVES
-// leaves at that ε, as those above but for the protocol's cost.
+// first filled (warm: none computed), then a third on it with the warm start, and, given
+// --merge-triangles=N, a fourth with its instances of at most N triangles merged into the
+// problems of those holding them.
+// Run: build/release/tests/leaflux_bench_daemon [out.csv [--merge-triangles=N]
+// [LEAVES:EPSILON ...]] (default out/bench/daemon_bench.csv); each LEAVES:EPSILON grows one
+// more tree of LEAVES leaves at that ε, as those above but for the protocol's cost.
 #include <spdlog/cfg/env.h>
 #include <spdlog/spdlog.h>
 
@@ -108,10 +109,6 @@ struct Row {
 constexpr std::pair<int, double> kGrowths[] = {{1000, 1e-4}, {1000, 3e-4},  {1000, 1e-3},
                                                {1000, 3e-3}, {10000, 1e-4}, {10000, 3e-4}};
 
-// The merge bound of the "instanced_merged" sessions: the generated trees' branches, of
-// 2,720 triangles on the 10,000-leaf plant, each solved as one problem with its twigs.
-constexpr std::int64_t kMergeTriangles = 4096;
-
 int main(int argc, char** argv) {
     using namespace leaflux;
     // Every request is logged at info level: SPDLOG_LEVEL=info shows them, debug the phases
@@ -119,7 +116,13 @@ int main(int argc, char** argv) {
     spdlog::set_level(spdlog::level::warn);
     spdlog::cfg::load_env_levels();
     std::vector<std::pair<int, double>> growths(std::begin(kGrowths), std::end(kGrowths));
+    long long mergeTriangles = 0;  // the "instanced_merged" sessions' bound; 0: none run
     for (int a = 2; a < argc; ++a) {
+        if (std::sscanf(argv[a], "--merge-triangles=%lld", &mergeTriangles) == 1) {
+            if (mergeTriangles > 0) continue;
+            std::fprintf(stderr, "%s: expected a positive triangle count\n", argv[a]);
+            return 2;
+        }
         int leaves = 0;
         double epsilon = 0.0;
         if (std::sscanf(argv[a], "%d:%lf", &leaves, &epsilon) != 2 || leaves <= 0 ||
@@ -219,9 +222,11 @@ int main(int argc, char** argv) {
         settings.set_warm_start(true);
         grow(fresh, "instanced_warm_start", leaves, settings);
         // Its small instances solved with those that hold them (merge_triangles).
-        settings.set_warm_start(false);
-        settings.mutable_instanced()->set_merge_triangles(kMergeTriangles);
-        grow(fresh, "instanced_merged", leaves, settings);
+        if (mergeTriangles > 0) {
+            settings.set_warm_start(false);
+            settings.mutable_instanced()->set_merge_triangles(mergeTriangles);
+            grow(fresh, "instanced_merged", leaves, settings);
+        }
     }
     const char* path = argc > 1 ? argv[1] : "out/bench/daemon_bench.csv";
     if (const auto folder = std::filesystem::path(path).parent_path(); !folder.empty())
