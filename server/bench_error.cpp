@@ -310,19 +310,18 @@ void WriteCsv(const std::string& path, const std::string& scene, int leaves,
             << (WorkingBytes(r.stats) >= 0
                     ? Number(static_cast<double>(WorkingBytes(r.stats)) / (1 << 20))
                     : std::string())
-            << ','
-            << r.stats.iterations << ',' << r.stats.links << ',' << Number(r.accuracy.l2PctOfMax)
-            << ',' << Number(r.accuracy.meanRelativePct) << ',' << Number(r.accuracy.p95RelativePct)
-            << ',' << Number(r.accuracy.referenceFloorPct) << ',' << r.accuracy.litLeaves << ','
-            << Number(r.balancePct) << '\n';
+            << ',' << r.stats.iterations << ',' << r.stats.links << ','
+            << Number(r.accuracy.l2PctOfMax) << ',' << Number(r.accuracy.meanRelativePct) << ','
+            << Number(r.accuracy.p95RelativePct) << ',' << Number(r.accuracy.referenceFloorPct)
+            << ',' << r.accuracy.litLeaves << ',' << Number(r.balancePct) << '\n';
     }
     if (!out) throw InputError(ErrorCode::kIo, path, "cannot write");
 }
 
 void PrintTable(const std::string& scene, const std::vector<Row>& rows) {
-    std::printf("%-12s %-6s %-16s %-5s %8s %8s %9s %11s %8s %9s %8s %8s %9s\n", "scene",
-                "solver", "setting", "band", "wall_s", "cpu_s", "peak_MiB", "working_MiB",
-                "L2_%max", "mean_rel%", "p95_rel%", "floor_%", "balance%");
+    std::printf("%-12s %-6s %-16s %-5s %8s %8s %9s %11s %8s %9s %8s %8s %9s\n", "scene", "solver",
+                "setting", "band", "wall_s", "cpu_s", "peak_MiB", "working_MiB", "L2_%max",
+                "mean_rel%", "p95_rel%", "floor_%", "balance%");
     for (const Row& r : rows) {
         const std::int64_t working = WorkingBytes(r.stats);
         std::printf("%-12s %-6s %-16s %-5s %8.3f %8.3f %9.0f %11s %8.3f %9.3f %8.3f %8.3f %9.3f\n",
@@ -330,8 +329,7 @@ void PrintTable(const std::string& scene, const std::vector<Row>& rows) {
                     r.stats.wallSeconds, r.stats.cpuSeconds,
                     static_cast<double>(r.stats.peakRssBytes) / (1 << 20),
                     working >= 0 ? std::to_string(working >> 20).c_str() : "-",
-                    r.accuracy.l2PctOfMax,
-                    r.accuracy.meanRelativePct, r.accuracy.p95RelativePct,
+                    r.accuracy.l2PctOfMax, r.accuracy.meanRelativePct, r.accuracy.p95RelativePct,
                     r.accuracy.referenceFloorPct, r.balancePct);
     }
 }
