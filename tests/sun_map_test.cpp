@@ -40,15 +40,17 @@ double Lit(const FlatScene& flat, const SunMap& map, std::uint32_t receiver) {
 // straight edge across the map can give to the wrong side are at most its length over
 // the pixel, each a pixel's area: the tolerance is the lengths of the lower leaf's outline
 // and of the shadow's edge across it, across the light, times the pixel, over its area
-// across the light.
-void ExpectHalfLit(double angularRadiusDeg) {
+// across the light. `upperAsked` false: the upper leaf's light is not asked for (SunMap's
+// `wanted`), yet it casts its shadow all the same.
+void ExpectHalfLit(double angularRadiusDeg, bool upperAsked = true) {
     const FlatScene flat = Leaves(
         {Quad({-0.05, -0.05, 0}, {0.05, -0.05, 0}, {0.05, 0.05, 0}, {-0.05, 0.05, 0}),
          Quad({0.05, -0.05, 0.05}, {0.15, -0.05, 0.05}, {0.15, 0.05, 0.05}, {0.05, 0.05, 0.05})});
     const RayScene rays(flat, std::nullopt);
     const glm::dvec3 toward = glm::normalize(glm::dvec3(1.0, 0.0, 1.0));
     const double cosRadius = std::cos(glm::radians(angularRadiusDeg));
-    const SunMap map(rays, 4, 4, toward, cosRadius);
+    const std::vector<std::uint8_t> asked = {1, 1, upperAsked, upperAsked};
+    const SunMap map(rays, 4, 4, toward, cosRadius, SunMap::kPixelsPerTriangle, asked);
     const double across = 0.01 * toward.z;
     const double outline = 2.0 * 0.1 * toward.z + 2.0 * 0.1, edge = 0.1;
     // A sun of some radius blurs the edge over 5 cm × tan(radius) on each side, evenly
@@ -56,10 +58,17 @@ void ExpectHalfLit(double angularRadiusDeg) {
     const double blur = 0.05 * std::tan(glm::radians(angularRadiusDeg)) * edge / across;
     const double tolerance = (outline + edge) * map.PixelM() / across + blur;
     EXPECT_NEAR(Lit(flat, map, 0), 0.5, tolerance);
-    EXPECT_NEAR(Lit(flat, map, 1), 1.0, outline * map.PixelM() / across);
+    if (upperAsked) {
+        EXPECT_NEAR(Lit(flat, map, 1), 1.0, outline * map.PixelM() / across);
+    } else {
+        EXPECT_EQ(map.Lit(2), -1.0);
+        EXPECT_EQ(map.Lit(3), -1.0);
+    }
 }
 
 TEST(SunMap, ALeafHalfInAnothersShadowIsHalfLit) { ExpectHalfLit(0.0); }
+
+TEST(SunMap, ALeafIsShadedByOneWhoseLightIsNotAskedFor) { ExpectHalfLit(0.0, false); }
 
 TEST(SunMap, ASunsDiscBlursTheShadowsEdgeWithoutMovingIt) { ExpectHalfLit(0.267); }
 

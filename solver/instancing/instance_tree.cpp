@@ -6,8 +6,10 @@
 #include <array>
 #include <limits>
 #include <span>
+#include <unordered_map>
 
 #include "solver/scene/topology.h"
+#include "solver/scene/world_frames.h"
 
 namespace leaflux {
 namespace {
@@ -144,6 +146,29 @@ void InstanceTree::Merge(std::int64_t triangles, const std::function<bool(std::u
         part.instances.clear();
         part.triangles = whole[p];
     }
+}
+
+std::vector<std::uint32_t> InstanceTree::Opened(
+    const std::function<bool(std::uint32_t, const glm::dmat4& worldFromRoot)>& opens,
+    const Scene* world) const {
+    std::vector<glm::dmat4> worldFromRoot(parts_.size(), glm::dmat4(1.0));
+    if (world != nullptr) {
+        std::unordered_map<NodeId, std::uint32_t> partOf;
+        for (std::uint32_t q = 0; q < parts_.size(); ++q) {
+            if (q != kTop && !parts_[q].merged) partOf.emplace(parts_[q].root, q);
+        }
+        ForEachWorldFrame(*world, [&](const Node& node, const glm::dmat4& worldFromLocal) {
+            if (const auto found = partOf.find(node.id); found != partOf.end())
+                worldFromRoot[found->second] = worldFromLocal;
+        });
+    }
+    std::vector<std::uint32_t> opened = {kTop};
+    for (std::size_t k = 0; k < opened.size(); ++k) {
+        for (std::uint32_t q : parts_[opened[k]].instances) {
+            if (opens(q, worldFromRoot[q])) opened.push_back(q);
+        }
+    }
+    return opened;
 }
 
 }  // namespace leaflux

@@ -53,6 +53,12 @@ class InstanceTree {
     // as `triangles` allows. 0: none.
     void Merge(std::int64_t triangles, const std::function<bool(std::uint32_t)>& opens);
 
+    // The parts reached from the top through the instances that `opens` (the top first),
+    // each placed by its root's frame in `world` when given (else the identity).
+    std::vector<std::uint32_t> Opened(
+        const std::function<bool(std::uint32_t, const glm::dmat4& worldFromRoot)>& opens,
+        const Scene* world = nullptr) const;
+
     const std::vector<Part>& Parts() const { return parts_; }
     const Part& operator[](std::uint32_t part) const { return parts_[part]; }
     int Depth() const { return depth_; }  // of the deepest instance (0: none)

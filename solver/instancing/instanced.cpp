@@ -179,10 +179,15 @@ class InstancedSolve {
     }
     ShadowView ShadowsOf(std::uint32_t p, const FlatScene& flat) const;
     // A map of each sun over the whole scene's triangles (SunMap): the light of the suns on
-    // every organ, found once for all the levels, for the sources the levels take.
+    // every organ solved, found once for all the levels, for the sources the levels take.
     void DrawSuns() {
-        sunMaps_ = leaflux::DrawSuns(receivers_, *shadows_, BeamsOf(scene_, options_.hrc.skyCones));
+        sunMaps_ = leaflux::DrawSuns(receivers_, *shadows_, BeamsOf(scene_, options_.hrc.skyCones),
+                                     SolvedTriangles());
     }
+    // Per organ triangle, whether an opened level holds it: those of the instances solved
+    // whole (Opens) are not asked for, and their leaves cost the maps nothing. Empty when
+    // every instance opens.
+    std::vector<std::uint8_t> SolvedTriangles() const;
     // The light that arrived on closed instance c of `level`, as the sources of its contents.
     std::vector<DirectionalSource> ArrivedOn(const LevelSolution& light, std::size_t c) const;
     // Each patch side that sends light, as an emitter held fixed (ReceiverKind::kHeld).
@@ -536,6 +541,21 @@ void InstancedSolve::OpenInstances(const Level& level, const LevelSolution& ligh
     tbb::parallel_for(std::size_t{0}, opened.size(), [&](std::size_t i) {
         Open(level, opened[i], std::move(arrived[i]), held, inherited + opened[i]);
     });
+}
+
+std::vector<std::uint8_t> InstancedSolve::SolvedTriangles() const {
+    if (options_.maxDepth == 0 && !options_.outputLevel && !options_.inView) return {};
+    std::vector<std::uint8_t> solved(organTriangles_, 0);
+    const auto opens = [&](std::uint32_t q, const glm::dmat4& world) { return Opens(q, world); };
+    for (std::uint32_t p : tree_.Opened(opens, options_.inView ? &scene_ : nullptr)) {
+        for (std::size_t i : tree_[p].nodes) {
+            const std::uint32_t global = OrganReceiver(scene_.nodes[i].id);
+            if (global == kNoReceiver) continue;
+            const Receiver& r = receivers_.receivers[global];
+            std::fill_n(solved.begin() + r.firstTriangle, r.triangleCount, std::uint8_t{1});
+        }
+    }
+    return solved;
 }
 
 bool InstancedSolve::HoldsInstanceOf(std::uint32_t q, NodeType type) const {

@@ -53,12 +53,12 @@ std::vector<DirectionalSource> UnitBeams(const Channels& channels,
 }
 
 SunMaps DrawSuns(const FlatScene& flat, const RayScene& rays,
-                 std::span<const DirectionalSource> sources) {
+                 std::span<const DirectionalSource> sources, std::span<const std::uint8_t> wanted) {
     std::vector<SunMaps::Sun> suns;
     for (const DirectionalSource& source : sources) {
         if (source.eachOrgan && source.beyond) suns.push_back({source.toward, source.cosRadius});
     }
-    return suns.empty() ? SunMaps{} : SunMaps(rays, flat, suns);
+    return suns.empty() ? SunMaps{} : SunMaps(rays, flat, suns, wanted);
 }
 
 }  // namespace leaflux

@@ -24,8 +24,10 @@ std::vector<DirectionalSource> UnitBeams(const Channels& channels,
                                          std::span<const glm::dvec3> towardSource);
 
 // The maps of a whole scene's suns (those of `sources` whose links reach each organ), over
-// the triangles of `rays`, numbered as `flat`'s.
+// the triangles of `rays`, numbered as `flat`'s; `wanted`: the organ triangles whose light
+// is asked (SunMap), or empty for all.
 SunMaps DrawSuns(const FlatScene& flat, const RayScene& rays,
-                 std::span<const DirectionalSource> sources);
+                 std::span<const DirectionalSource> sources,
+                 std::span<const std::uint8_t> wanted = {});
 
 }  // namespace leaflux

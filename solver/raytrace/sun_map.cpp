@@ -132,7 +132,9 @@ struct Counts {
 // Draws the scene's triangles across `toward` into `counts`: per organ triangle, the pixels
 // it covers and those where it is the nearest to the light.
 void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t organs,
-               const glm::dvec3& toward, double pixelsPerTriangle, Counts& counts) {
+               std::span<const std::uint8_t> wanted, const glm::dvec3& toward,
+               double pixelsPerTriangle, Counts& counts) {
+    const auto asked = [&](std::uint32_t t) { return t < organs && (wanted.empty() || wanted[t]); };
     Plane plane(toward);
     // The organs' extent and mean area across the light, which size the pixel.
     struct Extent {
@@ -186,6 +188,7 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
     // The tiles organs lie in, numbered.
     std::vector<std::uint8_t> organTile(tiles, 0);
     tbb::parallel_for(std::uint32_t{0}, organs, [&](std::uint32_t t) {
+        if (!asked(t)) return;
         const Drawn d = Draw(scene, plane, t);
         for (std::int64_t ty = d.y0 / kTile; ty <= d.y1 / kTile && d.y0 <= d.y1; ++ty) {
             for (std::int64_t tx = d.x0 / kTile; tx <= d.x1 / kTile && d.x0 <= d.x1; ++tx)
@@ -251,7 +254,7 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
                      });
         }
         for (std::size_t i = 0; i < list.size() && list[i] < organs; ++i) {
-            if (covered[i] == 0) continue;
+            if (covered[i] == 0 || !asked(list[i])) continue;
             EachSpan(Draw(scene, plane, list[i]), tx0, ty0, kTile,
                      [&](std::size_t at, std::int64_t n, double z, double dz) {
                          for (std::int64_t c = 0; c < n; ++c, z += dz) {
@@ -273,7 +276,8 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
 
 }  // namespace
 
-SunMaps::SunMaps(const RayScene& rays, const FlatScene& receivers, const std::vector<Sun>& suns) {
+SunMaps::SunMaps(const RayScene& rays, const FlatScene& receivers, const std::vector<Sun>& suns,
+                 std::span<const std::uint8_t> wanted) {
     if (rays.Periodic()) return;
     std::uint32_t triangles = 0, organs = 0;
     bool organsFirst = true;
@@ -284,19 +288,22 @@ SunMaps::SunMaps(const RayScene& rays, const FlatScene& receivers, const std::ve
     }
     if (organs == 0) return;
     for (const Sun& sun : suns)
-        maps.emplace_back(rays, triangles, organs, sun.toward, sun.cosRadius);
+        maps.emplace_back(rays, triangles, organs, sun.toward, sun.cosRadius,
+                          SunMap::kPixelsPerTriangle, wanted);
 }
 
 SunMap::SunMap(const RayScene& scene, std::uint32_t triangles, std::uint32_t organTriangles,
-               const glm::dvec3& toward, double cosRadius, double pixelsPerTriangle)
+               const glm::dvec3& toward, double cosRadius, double pixelsPerTriangle,
+               std::span<const std::uint8_t> wanted)
     : toward_(toward), cosRadius_(cosRadius), lit_(organTriangles, kNone) {
     LEAFLUX_CHECK(!scene.Periodic());
     LEAFLUX_CHECK(organTriangles <= triangles);
+    LEAFLUX_CHECK(wanted.empty() || wanted.size() == organTriangles);
     Counts counts{std::vector<std::uint32_t>(organTriangles, 0),
                   std::vector<std::uint32_t>(organTriangles, 0),
                   std::vector<std::uint8_t>(organTriangles, 0)};
     if (cosRadius >= 1.0) {
-        DrawAlong(scene, triangles, organTriangles, toward, pixelsPerTriangle, counts);
+        DrawAlong(scene, triangles, organTriangles, wanted, toward, pixelsPerTriangle, counts);
     } else {
         // Directions even in solid angle over the disc, turning by the golden angle.
         const Plane around(toward);
@@ -307,8 +314,8 @@ SunMap::SunMap(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
             const double phi = golden * k;
             const glm::dvec3 w = cosTheta * toward +
                                  sinTheta * (std::cos(phi) * around.u + std::sin(phi) * around.v);
-            DrawAlong(scene, triangles, organTriangles, glm::normalize(w), pixelsPerTriangle,
-                      counts);
+            DrawAlong(scene, triangles, organTriangles, wanted, glm::normalize(w),
+                      pixelsPerTriangle, counts);
         }
     }
     for (std::uint32_t t = 0; t < organTriangles; ++t) {

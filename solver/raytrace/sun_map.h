@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <span>
 #include <vector>
 
 #include "solver/raytrace/raytrace.h"
@@ -28,10 +29,13 @@ class SunMap {
 
     // Over the scene's first `triangles` triangles (not periodic), of which the first
     // `organTriangles` are lit; `toward`: unit, towards the sun; `cosRadius`: of its angular
-    // radius (1: a point).
+    // radius (1: a point). `wanted`, when not empty: per organ triangle, whether its light
+    // is asked; the others only cast shadows (Lit −1). Only the tiles where the wanted lie
+    // are drawn, on the pixels of the map of all: a wanted triangle's share is the same.
     SunMap(const RayScene& scene, std::uint32_t triangles, std::uint32_t organTriangles,
            const glm::dvec3& toward, double cosRadius,
-           double pixelsPerTriangle = kPixelsPerTriangle);
+           double pixelsPerTriangle = kPixelsPerTriangle,
+           std::span<const std::uint8_t> wanted = {});
 
     const glm::dvec3& Toward() const { return toward_; }
     double CosRadius() const { return cosRadius_; }
@@ -65,8 +69,10 @@ struct SunMaps {
         double cosRadius;
     };
     // Over the triangles of `rays`, numbered as the receivers of `receivers` number them,
-    // its organs first (Flatten, ReceiversOf); none in a periodic scene.
-    SunMaps(const RayScene& rays, const FlatScene& receivers, const std::vector<Sun>& suns);
+    // its organs first (Flatten, ReceiversOf); none in a periodic scene. `wanted`: as
+    // SunMap's.
+    SunMaps(const RayScene& rays, const FlatScene& receivers, const std::vector<Sun>& suns,
+            std::span<const std::uint8_t> wanted = {});
     SunMaps() = default;
 
     std::vector<SunMap> maps;
