@@ -147,27 +147,28 @@ def run_document(doc, build, source, workdir):
                                            os.path.join(build, "proto")]),
                PATH=os.pathsep.join([os.path.join(build, "server"),
                                      os.path.join(build, "growth_stub"), os.environ["PATH"]]))
-    runnable = [b for b in blocks(doc) if not b[4] and b[1] in ("sh", "python") and b[3] is None]
-    daemon, endpoint = None, None
-    if runnable:
-        daemon, endpoint, failure = start_daemon(build, env, state)
-        if failure:
-            return [], [], failure
-    script = ["set -euo pipefail",
-              f"trap 'echo \"FAILED in the block at $DOCS_TEST_BLOCK\" >&2' ERR"]
-    ran, skipped, ports = [], [], {}
+    # The blocks that run, the others set aside, the files written.
+    runnable, skipped = [], []
     for line, language, text, skip, target in blocks(doc):
         where = f"{os.path.relpath(doc, source)}:{line}"
         if target:
             path = os.path.join(checkout, target)
             os.makedirs(os.path.dirname(path), exist_ok=True)
             open(path, "w").write(text)
-            continue
-        if language not in ("sh", "python"):
-            continue
-        if skip is not None:
-            skipped.append(f"{where} ({skip})")
-            continue
+        elif language in ("sh", "python"):
+            if skip is None:
+                runnable.append((where, line, language, text))
+            else:
+                skipped.append(f"{where} ({skip})")
+    if not runnable:
+        return [], skipped, None
+    daemon, endpoint, failure = start_daemon(build, env, state)
+    if failure:
+        return [], [], failure
+    script = ["set -euo pipefail",
+              f"trap 'echo \"FAILED in the block at $DOCS_TEST_BLOCK\" >&2' ERR"]
+    ran, ports = [], {}
+    for where, line, language, text in runnable:
         ran.append(where)
         script.append(f"DOCS_TEST_BLOCK={where}; echo '### {where}'")
         if language == "python":
@@ -176,8 +177,6 @@ def run_document(doc, build, source, workdir):
             script.append(f"/usr/bin/python3 {name}")
         else:
             script.append(adjust(text, endpoint, state, ports))
-    if not ran:
-        return ran, skipped, None
     open(os.path.join(state, "run.sh"), "w").write("\n".join(script) + "\n")
     # The output goes to a file, not a pipe: what a block leaves running in the background
     # (a daemon) keeps a pipe open after the script has ended.
