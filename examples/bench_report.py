@@ -30,6 +30,7 @@ from report_suites import accuracy_section, stability_section
 
 RESULTS = os.path.join(ROOT, "docs", "results.md")
 DAEMON_RESULTS = os.path.join(ROOT, "docs", "results_daemon.md")  # the ray engine and daemon
+PHASE_RESULTS = os.path.join(ROOT, "docs", "results_phase.md")  # phase functions
 README = os.path.join(ROOT, "README.md")
 
 # name: (how to make the scene, what it is, bench error options)
@@ -511,7 +512,7 @@ def phase_spread_section(build, out, run=True):
                         os.path.join(REPORT, "phase_slices.csv"), os.path.join(REPORT, "phase_slices.png")],
                        check=True)
     rows = [r for r in csv.DictReader(open(os.path.join(REPORT, "phase_spread.csv"))) if r["band"] == "NIR"]
-    table = [f"![phase slices]({figure(RESULTS, 'phase_slices.png')})", "",
+    table = [f"![phase slices]({figure(PHASE_RESULTS, 'phase_slices.png')})", "",
              "| signature | members solved / in group | leaves | τ spread % (noise) | f spread % | f rep. error % | "
              "f/leaf area rep. error % | scattered rep. error % | intercepted rep. error % (noise) | nearest other group | "
              "f error with its rep. % | f/leaf area error with its rep. % |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -563,8 +564,8 @@ def main():
         update(RESULTS, "scaling", scaling_section(build, os.path.join(out, "scaling"), args.scaling_solvers, run))
     if "phase" in parts:
         table, times = phase_sections(build, os.path.join(out, "phase"), run)
-        update(RESULTS, "phase-table", table)
-        update(RESULTS, "phase-functions", times)
+        update(PHASE_RESULTS, "phase-table", table)
+        update(PHASE_RESULTS, "phase-functions", times)
     if "growth" in parts:
         update(RESULTS, "growth", growth_section(args.demo, run))
         if "render" not in parts and os.path.exists(os.path.join(REPORT, "render.csv")):
@@ -587,9 +588,9 @@ def main():
     if "rays" in parts:
         update(DAEMON_RESULTS, "rays", rays_section(build, os.path.join(out, "rays"), run))
     if "phase-db" in parts:
-        update(RESULTS, "phase-db", phase_db_section(build, os.path.join(out, "phase"), run))
+        update(PHASE_RESULTS, "phase-db", phase_db_section(build, os.path.join(out, "phase"), run))
     if "phase-spread" in parts:
-        update(RESULTS, "phase-spread", phase_spread_section(build, os.path.join(out, "phase_spread"), run))
+        update(PHASE_RESULTS, "phase-spread", phase_spread_section(build, os.path.join(out, "phase_spread"), run))
     if "import" in parts:
         update(RESULTS, "import", import_section(build, os.path.join(out, "import"), run,
                                                  args.import_largest))
@@ -597,7 +598,7 @@ def main():
         update(README, "accuracy", accuracy_section(build, os.path.join(out, "accuracy"), run))
     if "stability" in parts:
         update(RESULTS, "stability", stability_section(build, os.path.join(out, "stability"), run))
-    print(f"sections {args.only} rewritten in docs/results.md or docs/results_daemon.md"
+    print(f"sections {args.only} rewritten in docs/results.md, results_daemon.md or results_phase.md"
           f"{' and the summary in README.md' if 'error' in parts or 'summary' in parts else ''}; files in {REPORT}")
 
 
