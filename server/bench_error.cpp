@@ -463,7 +463,8 @@ int RunErrorBench(const ErrorBenchOptions& options) {
     PhaseDatabase originals(PhaseDatabaseOptions{});  // the instanced runs'
     for (Run run : Runs(options)) {
         // The solver's working memory: its peak less what the process held before it (the
-        // scene, the reference, the phase functions the earlier runs put in memory).
+        // scene, flattened and in the ray engine, the reference, the phase functions the
+        // earlier runs put in memory).
         const bool peakReset = ResetPeakRss();
         const std::int64_t before = ResidentBytes();
         run.settings.instanced.database = &originals;

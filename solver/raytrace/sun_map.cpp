@@ -185,7 +185,7 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
     const double coplanar = std::ldexp(
         std::max({1.0, glm::length(frame.boundsMin), glm::length(frame.boundsMax)}), -21);
     counts.pixelM = std::max(counts.pixelM, plane.size);
-    // The tiles organs lie in, numbered.
+    // The tiles the organs asked for lie in, numbered.
     std::vector<std::uint8_t> organTile(tiles, 0);
     tbb::parallel_for(std::uint32_t{0}, organs, [&](std::uint32_t t) {
         if (!asked(t)) return;
