@@ -171,4 +171,24 @@ std::vector<std::uint32_t> InstanceTree::Opened(
     return opened;
 }
 
+bool InstanceTree::HoldsInstanceOf(const Scene& scene, std::uint32_t q, NodeType type) const {
+    for (std::uint32_t inner : parts_[q].instances) {
+        if (scene.nodes[parts_[inner].rootIndex].type == type ||
+            HoldsInstanceOf(scene, inner, type))
+            return true;
+    }
+    return false;
+}
+
+bool InstanceTree::HoldsNodeOf(const Scene& scene, std::uint32_t q, NodeType type) const {
+    for (std::size_t i : parts_[q].nodes) {
+        if (i != parts_[q].rootIndex && scene.nodes[i].type == type) return true;
+    }
+    for (std::uint32_t inner : parts_[q].instances) {
+        if (scene.nodes[parts_[inner].rootIndex].type == type || HoldsNodeOf(scene, inner, type))
+            return true;
+    }
+    return false;
+}
+
 }  // namespace leaflux

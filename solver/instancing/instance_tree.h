@@ -59,6 +59,12 @@ class InstanceTree {
         const std::function<bool(std::uint32_t, const glm::dmat4& worldFromRoot)>& opens,
         const Scene* world = nullptr) const;
 
+    // Whether part q holds an instance of `type`, in it or in its instances (`scene`: the
+    // tree's).
+    bool HoldsInstanceOf(const Scene& scene, std::uint32_t q, NodeType type) const;
+    // Whether a node of `type` lies in part q under its root, in it or in its instances.
+    bool HoldsNodeOf(const Scene& scene, std::uint32_t q, NodeType type) const;
+
     const std::vector<Part>& Parts() const { return parts_; }
     const Part& operator[](std::uint32_t part) const { return parts_[part]; }
     int Depth() const { return depth_; }  // of the deepest instance (0: none)

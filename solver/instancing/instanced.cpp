@@ -205,9 +205,6 @@ class InstancedSolve {
     // Whether part q, placed by worldFromRoot, is opened (InstancedOptions::maxDepth,
     // outputLevel, inView).
     bool Opens(std::uint32_t q, const glm::dmat4& worldFromRoot) const;
-    bool HoldsInstanceOf(std::uint32_t q, NodeType type) const;
-    // Whether a node of `type` lies in part q under its root, in it or in its instances.
-    bool HoldsNodeOf(std::uint32_t q, NodeType type) const;
     // Closed instance c of `level` solved whole from the light that arrived on it.
     void SolveWhole(const Level& level, const LevelSolution& light, std::size_t c);
     // Where the organs of part q and of the parts in it lie in the shadow engine
@@ -558,25 +555,6 @@ std::vector<std::uint8_t> InstancedSolve::SolvedTriangles() const {
     return solved;
 }
 
-bool InstancedSolve::HoldsInstanceOf(std::uint32_t q, NodeType type) const {
-    for (std::uint32_t inner : tree_[q].instances) {
-        if (scene_.nodes[tree_[inner].rootIndex].type == type || HoldsInstanceOf(inner, type))
-            return true;
-    }
-    return false;
-}
-
-bool InstancedSolve::HoldsNodeOf(std::uint32_t q, NodeType type) const {
-    for (std::size_t i : tree_[q].nodes) {
-        if (i != tree_[q].rootIndex && scene_.nodes[i].type == type) return true;
-    }
-    for (std::uint32_t inner : tree_[q].instances) {
-        if (scene_.nodes[tree_[inner].rootIndex].type == type || HoldsNodeOf(inner, type))
-            return true;
-    }
-    return false;
-}
-
 bool InstancedSolve::Opens(std::uint32_t q, const glm::dmat4& worldFromRoot) const {
     if (options_.maxDepth > 0 && tree_[q].depth > options_.maxDepth) return false;
     if (options_.inView) {
@@ -588,8 +566,8 @@ bool InstancedSolve::Opens(std::uint32_t q, const glm::dmat4& worldFromRoot) con
     // another type (a plant, for light per axis) holding structures of the type that are
     // not instances opens too, so that they are solved.
     const NodeType type = *options_.outputLevel;
-    return HoldsInstanceOf(q, type) ||
-           (scene_.nodes[tree_[q].rootIndex].type != type && HoldsNodeOf(q, type));
+    return tree_.HoldsInstanceOf(scene_, q, type) ||
+           (scene_.nodes[tree_[q].rootIndex].type != type && tree_.HoldsNodeOf(scene_, q, type));
 }
 
 void InstancedSolve::ShadowTriangles(std::uint32_t q, ClosedNode& closed) const {
