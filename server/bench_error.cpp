@@ -304,12 +304,11 @@ void WriteCsv(const std::string& path, const std::string& scene, int leaves,
            "l2_pct_of_max,mean_rel_pct,p95_rel_pct,reference_floor_pct,lit_leaves,"
            "balance_residual_pct\n";
     for (const Row& r : rows) {
+        const std::int64_t working = WorkingBytes(r.stats);
         out << scene << ',' << leaves << ',' << r.solver << ',' << r.setting << ',' << r.band << ','
             << Number(r.stats.wallSeconds) << ',' << Number(r.stats.cpuSeconds) << ','
             << Number(static_cast<double>(r.stats.peakRssBytes) / (1 << 20)) << ','
-            << (WorkingBytes(r.stats) >= 0
-                    ? Number(static_cast<double>(WorkingBytes(r.stats)) / (1 << 20))
-                    : std::string())
+            << (working >= 0 ? Number(static_cast<double>(working) / (1 << 20)) : std::string())
             << ',' << r.stats.iterations << ',' << r.stats.links << ','
             << Number(r.accuracy.l2PctOfMax) << ',' << Number(r.accuracy.meanRelativePct) << ','
             << Number(r.accuracy.p95RelativePct) << ',' << Number(r.accuracy.referenceFloorPct)

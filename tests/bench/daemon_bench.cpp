@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string_view>
 #include <thread>
 #include <utility>
 
@@ -118,8 +119,11 @@ int main(int argc, char** argv) {
     std::vector<std::pair<int, double>> growths(std::begin(kGrowths), std::end(kGrowths));
     long long mergeTriangles = 0;  // the "instanced_merged" sessions' bound; 0: none run
     for (int a = 2; a < argc; ++a) {
-        if (std::sscanf(argv[a], "--merge-triangles=%lld", &mergeTriangles) == 1) {
-            if (mergeTriangles > 0) continue;
+        if (std::string_view(argv[a]).starts_with("--merge-triangles=")) {
+            char rest = 0;
+            if (std::sscanf(argv[a], "--merge-triangles=%lld%c", &mergeTriangles, &rest) == 1 &&
+                mergeTriangles > 0)
+                continue;
             std::fprintf(stderr, "%s: expected a positive triangle count\n", argv[a]);
             return 2;
         }
