@@ -73,11 +73,16 @@ void PushPull::PullNode(Field& field, std::uint32_t n) const {
             for (int i = 0; i < bins * channels; ++i) out[i] += in[i];
             continue;
         }
+        // A patch faces each direction with one side: the other's lobe is 0 there.
+        thread_local std::vector<double> lobes;
+        lobes.resize(2 * static_cast<std::size_t>(bins));
+        model_.BinLobes(c, lobes.data());
+        const double* upper = field.radiosity(child, kUpper);
+        const double* lower = field.radiosity(child, kLower);
+        const double scale = c.areaM2 / kPi;
         for (int d = 0; d < bins; ++d) {
-            const auto [side, lobe] = model_.BinCosine(c, d);
-            const double scale = c.areaM2 * lobe / kPi;
-            const double* radiosity = field.radiosity(child, side);
-            for (int k = 0; k < channels; ++k) out[d * channels + k] += scale * radiosity[k];
+            const double u = scale * lobes[d], l = scale * lobes[bins + d];
+            for (int k = 0; k < channels; ++k) out[d * channels + k] += u * upper[k] + l * lower[k];
         }
     }
 }
@@ -267,22 +272,33 @@ void PushPull::PushDown(const Links& links, const Gathered& gathered, const Sour
             std::copy(sum.begin(), sum.end(), closed->bins[node.closed]);
             return;
         }
-        // The clusters' light on t's normal, once for the patches t was split into.
+        // The clusters' light on t's normal, once for the patches t was split into; none
+        // from the directions an inner side faces.
         scratch.top.assign(Arrival::Width(channels), 0.0);
+        scratch.lobes.resize(2 * static_cast<std::size_t>(bins));
+        model_.BinLobes(node, scratch.lobes.data());
+        const bool inner[2] = {model_.Inner(node.triangle, kUpper),
+                               model_.Inner(node.triangle, kLower)};
+        const double* upper = scratch.lobes.data();
+        const double* lower = upper + bins;
         const Arrival in{scratch.top.data(), channels};
-        for (int d = 0; d < bins; ++d) {
-            const glm::dvec3& omega = directions.Direction(d);
-            const auto [side, lobe] = model_.BinCosine(node, d);
-            if (model_.Inner(node.triangle, side)) continue;
-            for (int k = 0; k < channels; ++k) {
-                const double normal = sum[d * channels + k];
-                in.Side(side)[k] += normal * lobe;
-                if constexpr (kDirections) {
+        for (int k = 0; k < channels; ++k) {
+            double side[2] = {0.0, 0.0};
+            for (int d = 0; d < bins; ++d) {
+                side[kUpper] += sum[d * channels + k] * upper[d];
+                side[kLower] += sum[d * channels + k] * lower[d];
+            }
+            for (int s : {kUpper, kLower}) in.Side(s)[k] += inner[s] ? 0.0 : side[s];
+            if constexpr (kDirections) {
+                glm::dvec3 moment(0.0);
+                for (int d = 0; d < bins; ++d) {
+                    if (inner[upper[d] > 0.0 ? kUpper : kLower]) continue;
+                    const double normal = sum[d * channels + k];
                     in.Integral()[k] += normal;
-                    double* moment = in.Moment(k);
-                    const glm::dvec3 part = normal * omega;
-                    moment[0] += part.x, moment[1] += part.y, moment[2] += part.z;
+                    moment += normal * directions.Direction(d);
                 }
+                double* out = in.Moment(k);
+                out[0] += moment.x, out[1] += moment.y, out[2] += moment.z;
             }
         }
         // What t, the patches it was split from and the flat clusters above gathered.

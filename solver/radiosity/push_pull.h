@@ -55,7 +55,7 @@ class PushPull {
     // Per task: buffers reused from patch to patch, so that handing light down allocates
     // nothing per node (a deque, whose elements stay where they are as it grows).
     struct Scratch {
-        std::vector<double> top;
+        std::vector<double> top, lobes;
         std::deque<std::vector<double>> levels;
     };
     void PullNode(Field& field, std::uint32_t n) const;
