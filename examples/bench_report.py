@@ -70,6 +70,15 @@ SCENES = {
                    "every solver solving all of it",
                    ["--reference-samples", "8192", "--sample-plants", "5", "--mc-samples", "256",
                     "--hrc-epsilon", "1e-4,1e-5", "--instanced-epsilon", "1e-4,1e-5,3e-6"]),
+    "copies": (["--leaves", "8000", "--seed", "2", "--rows", "15", "--columns", "16", "--trees", "233",
+                "--copies", "--prototypes", "4", "--instanced", "--sky-cones", "turtle46"],
+               "the paper's plantation (Soler 2003 Fig. 16): 233 generated trees of 8,000 leaves, "
+               "about 5 M polygons, copies of 4 prototype trees written as an instanced scene, sun + "
+               "46-cone overcast sky; the reference and every error over the leaves of 5 of its "
+               "trees (`--sample-plants 5`), the instanced solver solving all of it (HRC needed "
+               "13 GiB for 10⁶ leaves and Monte Carlo 23 minutes: neither runs here)",
+               ["--max-nodes", "6000000", "--reference-samples", "4096", "--sample-plants", "5",
+                "--no-mc", "--no-hrc", "--no-direct", "--instanced-epsilon", "1e-3"]),
     "greenhouse": (["--greenhouse", "--rows", "3", "--columns", "8", "--spacing", "0.8",
                     "--row-spacing", "1.4", "--leaves", "200", "--leaf-length", "0.06"],
                    "greenhouse at night: 24 plants of 200 leaves, white floor and walls, "
@@ -145,7 +154,7 @@ SUMMARY = [("mc", "samples", 1024, "Monte Carlo, 1,024 paths"), ("hrc", "epsilon
 
 # The README's rows: the plantation's errors are over a sample of its trees, and its table
 # in docs/results.md says so.
-SUMMARY_SCENES = [name for name in SCENES if name != "plantation"]
+SUMMARY_SCENES = [name for name in SCENES if name not in ("plantation", "copies")]
 
 
 def summary_section(names):
@@ -193,7 +202,8 @@ def scaling_section(build, out, solvers, run=True):
 
 def largest_scenes(rows):
     """The largest scene of each series, solver by solver, and which runs met the paper's
-    goal for the plantation (Soler 2003 §7: ≤ 2 minutes and ≤ 300 MB in all)."""
+    goal for its plantation of 233 trees and about 5 M polygons (Soler 2003 §7, Fig. 16: ≤ 2
+    minutes and ≤ 300 MB in all), the plantation of copies."""
     goal_mib = 300e6 / 2**20
     text = []
     for series in dict.fromkeys(r["series"] for r in rows):
@@ -206,13 +216,22 @@ def largest_scenes(rows):
             f"{r['solver']} {number(r['wall_s'])} s, {number(r['peak_mib'])} MiB"
             + (f" ({number(float(r['solving_mib']) - float(r['loaded_mib']))} working)"
                if r.get("solving_mib") else "") for r in at)
-        scene = (f"{int(at[0]['trees'])} trees, {largest:,} leaves" if series == "trees"
-                 else f"One tree of {largest:,} leaves")
+        trees = int(at[0]["trees"])
+        scene = {"one tree": f"One tree of {largest:,} leaves",
+                 "trees": f"{trees} trees, {largest:,} leaves",
+                 "copies": f"{trees} copies of 4 trees, {largest:,} leaves"}[series]
         line = f"{scene}: {runs}."
-        if series == "trees":
-            met = [r["solver"] for r in at if float(r["wall_s"]) <= 120 and float(r["peak_mib"]) <= goal_mib]
-            line += (f" The paper's goal for such a plantation, ≤ 2 minutes and ≤ 300 MB "
-                     f"({goal_mib:.0f} MiB) in all: met by {', '.join(met) if met else 'none'}.")
+        if series == "copies":
+            # In all: the process's time, reading the scene included, where it was measured.
+            whole = {r["solver"]: float(r.get("process_s") or r["wall_s"]) for r in at}
+            line += " In all, reading the scene included: " + "; ".join(
+                f"{r['solver']} {number(whole[r['solver']])} s (the scene once read: "
+                f"{number(r['loaded_mib'])} MiB)" for r in at if r.get("loaded_mib")) + "."
+            met = [r["solver"] for r in at
+                   if whole[r["solver"]] <= 120 and float(r["peak_mib"]) <= goal_mib]
+            line += (f" The paper's goal for its plantation (233 trees, about 5 M polygons), ≤ 2 "
+                     f"minutes and ≤ 300 MB ({goal_mib:.0f} MiB) in all: met by "
+                     f"{', '.join(met) if met else 'none'}.")
         text.append(line)
     return "\n\n".join(text)
 

@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """Time and peak memory against scene size, each solver at one setting, a fresh process
-per run (peak memory is the process's): one generated tree of 1k to 10⁶ leaves, and
-plantations of 1 to 233 trees of 1,000 leaves. Fits the growth exponent of time, peak
+per run (peak memory is the process's): one generated tree of 1k to 10⁶ leaves,
+plantations of 1 to 233 trees of 1,000 leaves, and the paper's plantation (Soler 2003 Fig. 16):
+233 trees of 8,000 leaves, about 5 M polygons, copies of 4 prototype trees written as an
+instanced scene. Fits the growth exponent of time, peak
 memory and working memory (the peak while solving less the memory once the scene is
 loaded) per series and solver (paper §3.5: HRC's n·log n time and super-linear memory are
 the baseline instantiation must beat). The instanced solver runs at HRC's ε from a phase-function
@@ -11,9 +13,10 @@ engine's compact hierarchy (`instanced-compact`) and by transmittance (`instance
 which never holds the whole scene's triangles).
 
 Usage: bench_scaling.py BUILD_DIR OUT_DIR [--leaves 1000,10000,100000,1000000]
-                        [--trees 1,4,16,64,233] [--epsilon 1e-5] [--samples 256]
+                        [--trees 1,4,16,64,233] [--copies 233] [--copies-leaves 8000]
+                        [--epsilon 1e-5] [--samples 256]
                         [--solvers hrc,mc,instanced,instanced-compact,instanced-tau]
-                        [--tau-leaves 250000]
+                        [--tau-leaves 250000] [--hrc-leaves 1000000] [--mc-leaves 1000000]
 Writes OUT_DIR/scaling.csv, OUT_DIR/fits.csv and OUT_DIR/scaling.png and prints the table.
 A run that fails (out of memory) is a row with its exit status and no figures.
 """
@@ -22,6 +25,7 @@ import csv
 import math
 import os
 import subprocess
+import time
 
 from summary import generate_tree, solve
 
@@ -44,7 +48,10 @@ SOLVERS = {
                                                       "--phase-db", db, "--shadows", "transmittance"]),
 }
 COLUMNS = ["series", "leaves", "trees", "solver", "setting", "wall_s", "cpu_s", "peak_mib", "loaded_mib",
-           "solving_mib", "links", "elements", "status"]
+           "solving_mib", "links", "elements", "process_s", "status"]
+SERIES = ("one tree", "trees", "copies")
+# The scenes' largest node count: the paper's plantation expands to 4.3 M nodes.
+MAX_NODES = "6000000"
 
 
 def working_mib(row):
@@ -65,6 +72,19 @@ def plantation(leaflux, out_dir, trees):
     return scene
 
 
+def copies_plantation(leaflux, out_dir, trees, leaves):
+    """`trees` trees of `leaves` leaves, 6 m apart on a square grid, copies of 4 prototype
+    trees each turned about z, written instanced (the file grows with the placements, not
+    the polygons); returns the scene path."""
+    scene = os.path.join(out_dir, f"copies{trees}x{leaves}.scene.binpb")
+    columns = math.ceil(math.sqrt(trees))
+    subprocess.run([leaflux, "generate", "--leaves", str(leaves), "--seed", "2", "--rows",
+                    str(math.ceil(trees / columns)), "--columns", str(columns), "--trees", str(trees),
+                    "--copies", "--prototypes", "4", "--instanced", "--out", scene],
+                   check=True, capture_output=True)
+    return scene
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("build", help="the build folder, with server/leaflux")
@@ -76,6 +96,12 @@ def main():
     parser.add_argument("--trees", default="1,4,16,64,233",
                         help="trees of 1,000 leaves in each plantation, comma-separated; empty: "
                         "none (default: %(default)s)")
+    parser.add_argument("--copies", default="233",
+                        help="trees of the plantation of copies (the paper's Fig. 16); empty: none "
+                        "(default: %(default)s)")
+    parser.add_argument("--copies-leaves", type=int, default=8000,
+                        help="leaves of each tree of the plantation of copies: 8,000 makes 233 "
+                        "trees about 5 M polygons (default: %(default)s)")
     parser.add_argument("--epsilon", default="1e-5", help="HRC's ε (default: %(default)s)")
     parser.add_argument("--samples", default="256",
                         help="Monte Carlo paths per receiver (default: %(default)s)")
@@ -83,6 +109,12 @@ def main():
                         help="instanced-tau runs on scenes of at most this many leaves: its "
                         "shadows through every closed instance's τ take several times the "
                         "time of shadows by geometry (default: %(default)s)")
+    parser.add_argument("--hrc-leaves", type=int, default=1000000,
+                        help="HRC runs on scenes of at most this many leaves: it needed 13 GiB "
+                        "for 10⁶ (default: %(default)s)")
+    parser.add_argument("--mc-leaves", type=int, default=1000000,
+                        help="Monte Carlo runs on scenes of at most this many leaves: it took 23 "
+                        "minutes for 10⁶ (default: %(default)s)")
     parser.add_argument("--solvers", default=",".join(SOLVERS),
                         help="solvers to run; the rows of the others, and of the scenes not run, "
                         "are kept from OUT/scaling.csv (default: %(default)s)")
@@ -96,7 +128,7 @@ def main():
         for r in csv.DictReader(open(previous)):
             for key in ("leaves", "trees", "links", "elements"):
                 r[key] = int(r[key]) if r[key] else ""
-            for key in ("wall_s", "cpu_s", "peak_mib", "loaded_mib", "solving_mib"):
+            for key in ("wall_s", "cpu_s", "peak_mib", "loaded_mib", "solving_mib", "process_s"):
                 r[key] = float(r[key]) if r.get(key) else ""
             kept[(r["series"], r["leaves"], r["solver"])] = r
     leaflux = os.path.join(args.build, "server", "leaflux")
@@ -105,6 +137,10 @@ def main():
               for n in args.leaves.split(",") if n]
     scenes += [("trees", 1000 * int(t), int(t), lambda t=int(t): plantation(leaflux, args.out, t))
                for t in args.trees.split(",") if t]
+    scenes += [("copies", args.copies_leaves * int(t), int(t),
+                lambda t=int(t): copies_plantation(leaflux, args.out, t, args.copies_leaves))
+               for t in args.copies.split(",") if t]
+    most_leaves = {"instanced-tau": args.tau_leaves, "hrc": args.hrc_leaves, "mc": args.mc_leaves}
     rows = []
     run_scenes = {(series, leaves) for series, leaves, _, _ in scenes}
     rows += [r for (series, leaves, _), r in kept.items() if (series, leaves) not in run_scenes]
@@ -118,26 +154,29 @@ def main():
                 continue
             setting, options = SOLVERS[solver](args, database)
             row = dict(series=series, leaves=leaves, trees=trees, solver=solver, setting=setting)
-            if solver == "instanced-tau" and leaves > args.tau_leaves:
-                row.update(status=f"not run (over --tau-leaves {args.tau_leaves})")
+            if leaves > most_leaves.get(solver, leaves):
+                row.update(status=f"not run (over --{solver.split('-')[-1]}-leaves {most_leaves[solver]})")
                 rows.append(row)
                 continue
             try:
                 out = os.path.join(args.out, f"{series[0]}{leaves}_{solver}.csv")
-                options = options + ["--max-nodes", "3000000"]  # a tree of 10^6 leaves has 2.3 M
+                options = options + ["--max-nodes", MAX_NODES]
+                start = time.monotonic()
                 result = solve(leaflux, scene, out, options)
                 if result.get("phase_computed"):  # its functions are in the database now
+                    start = time.monotonic()
                     result = solve(leaflux, scene, out, options)
+                result["process_s"] = round(time.monotonic() - start, 2)  # reading the scene too
                 result.pop("residual_pct")
                 result.pop("phase_computed", None)
                 row.update(result, status="ok")
             except subprocess.CalledProcessError as e:
                 row.update(wall_s="", cpu_s="", peak_mib="", loaded_mib="", solving_mib="", links="", elements="",
-                           status=f"failed (exit {e.returncode})")
+                           process_s="", status=f"failed (exit {e.returncode})")
             rows.append(row)
             print(f"{series:<9} {leaves:>8} {trees:>4} {solver:<4} {row['status']:<16} "
                   f"{row['wall_s']!s:>9} s {row['peak_mib']!s:>7} MiB", flush=True)
-    rows.sort(key=lambda r: (("one tree", "trees").index(r["series"]), r["leaves"], list(SOLVERS).index(r["solver"])))
+    rows.sort(key=lambda r: (SERIES.index(r["series"]), r["leaves"], list(SOLVERS).index(r["solver"])))
     with open(os.path.join(args.out, "scaling.csv"), "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=COLUMNS, restval="")
         writer.writeheader()
@@ -169,7 +208,7 @@ def main():
     except ImportError:
         return
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.6))
-    for series, style in (("one tree", "-"), ("trees", "--")):
+    for series, style in zip(SERIES, ("-", "--", ":")):
         for solver, marker, colour in zip(SOLVERS, ("s", "o", "^", "D", "v"), ("C0", "C1", "C2", "C4", "C3")):
             points = [r for r in rows if r["series"] == series and r["solver"] == solver and r["status"] == "ok"]
             if not points:

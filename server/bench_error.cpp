@@ -393,7 +393,7 @@ int RunErrorBench(const ErrorBenchOptions& options) {
     // Before the reference, which may take hours, as solve --out is checked before its solve.
     CheckWritable(options.csv, "--out");
     if (!options.png.empty()) CheckWritable(options.png, "--out");
-    const Scene scene = LoadSceneFile(options.scene);
+    const Scene scene = LoadSceneFile(options.scene, options.file);
     const std::string& name = options.name;
     PreparedScene prepared(scene);
     const FlatScene& flat = prepared.Flat();

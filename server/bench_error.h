@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "server/scene_file_cli.h"
 #include "solver/instancing/policy.h"
 #include "solver/radiosity/hrc.h"
 
@@ -16,6 +17,7 @@ namespace leaflux {
 
 struct ErrorBenchOptions {
     std::string scene;       // scene file
+    SceneFileOptions file;   // --strict, --max-nodes
     std::string name;        // the scene's name in the CSV and the log
     std::string csv;         // where to write the rows
     std::string png;         // where to plot them (none when empty)

@@ -98,6 +98,7 @@ int main(int argc, char** argv) {
     errorApp->add_option("--scene", errorBench.scene, "Scene file")
         ->required()
         ->check(CLI::ExistingFile);
+    AddSceneFileOptions(*errorApp, errorBench.file);
     errorApp->add_option("--name", errorBench.name, "The scene's name (default: the file's)");
     errorApp->add_option("--out", errorBenchOut,
                          "Directory of the CSV and the plot (made; checked before the "
