@@ -18,6 +18,7 @@
 #include "solver/instancing/scene_originals.h"
 #include "solver/instancing/signature.h"
 #include "solver/radiosity/beams.h"
+#include "solver/radiosity/closed_exchange.h"
 #include "solver/raytrace/occlusion.h"
 #include "solver/scene/geometry.h"
 #include "solver/scene/subtrees.h"
@@ -463,6 +464,7 @@ std::shared_ptr<const HeldOutside> InstancedSolve::HeldBy(const Level& level,
         // A level nothing lit hands on no intensity: its instances send nothing.
         if (closed.held.empty())
             closed.held.assign(static_cast<std::size_t>(light.bins) * scene_.bands.size(), 0.0);
+        if (closed.heldDepth.empty()) closed.heldDepth = HeldDepths(closed, directions_);
         held->closed.push_back(std::move(closed));
     };
     for (std::size_t c = owned; c < level.closed.size(); ++c) hold(c);

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "solver/util/box.h"
+#include "solver/util/check.h"
 
 namespace leaflux {
 namespace {
@@ -149,6 +150,17 @@ std::vector<NodeLink> OverlappingClosedLinks(const NodeModel& model, std::uint32
     return links;
 }
 
+std::vector<double> HeldDepths(const ClosedNode& node, const DirectionSet& directions) {
+    std::vector<double> depths(directions.Size());
+    for (int d = 0; d < directions.Size(); ++d) {
+        const glm::dvec3& omega = directions.Direction(d);
+        depths[d] = -std::log(std::clamp(node.contents->Transmittance(node.ToInstance(omega)),
+                                         kLeastTransmittance, 1.0)) *
+                    node.BoxProjectedArea(omega);
+    }
+    return depths;
+}
+
 std::vector<NodeLink> HeldAroundLinks(
     const NodeModel& model, std::uint32_t r, std::uint32_t s,
     const std::function<double(const Hierarchy::Point&, const glm::dvec3&, double)>& passed,
@@ -171,6 +183,11 @@ std::vector<NodeLink> HeldAroundLinks(
             points.emplace_back(instanceFromScene * glm::dvec4(at.back().position, 1.0));
         }
     }
+    // The light arriving inside the box is not yet dimmed by the organs it has still to pass
+    // on its way out, which I(ω) holds: per unit of ∫ e dℓ between the point and where the
+    // light leaves the box, the box's mean optical depth along ω.
+    const std::vector<double>& depths = sender.heldDepth;
+    LEAFLUX_CHECK(depths.size() == static_cast<std::size_t>(directions.Size()));
     std::vector<NodeLink> links;
     for (int d = 0; d < directions.Size(); ++d) {
         const glm::dvec3& omega = directions.Direction(d);  // the way the light goes
@@ -178,14 +195,7 @@ std::vector<NodeLink> HeldAroundLinks(
         // The mean over r's points, by their area facing the light, of ∫ e dℓ (1/m²) as far
         // as seen from each.
         double behind = 0.0;
-        // The light arriving inside the box is not yet dimmed by the organs it has still to
-        // pass on its way out, which I(ω) holds: per unit of ∫ e dℓ between the point and
-        // where the light leaves the box, the box's mean optical depth along ω, −ln τ(ω)
-        // over its section A⊥ (for which ∫ e dℓ is 1 / A⊥ on the mean).
-        const double depth =
-            -std::log(std::clamp(sender.contents->Transmittance(sender.ToInstance(omega)),
-                                 kLeastTransmittance, 1.0)) *
-            sender.BoxProjectedArea(omega);
+        const double depth = depths[d];
         // A point of each row of r's grid, in a column that turns with the bin: each bin
         // sees r's whole extent, and the bins together every point.
         double weights = 0.0;

@@ -54,6 +54,10 @@ struct ClosedNode {
     // the cluster light's set and channel, [bin][channel] in W/sr. It sends that, receives
     // nothing, and is not in the rays' scene (its proxy is the level's that holds it).
     std::vector<double> held;
+    // Held: per direction of the cluster light's set (the way the light goes), the box's mean
+    // optical depth along it (HeldDepths), which every receiver of its light from all around
+    // takes (HeldAroundLinks).
+    std::vector<double> heldDepth;
     // Its organs' triangles in the whole scene's shadow engine (ShadowView), when it has
     // one: what its intensity already lost to them is not lost again (HeldAroundLinks).
     std::shared_ptr<const RayScene::TriangleRanges> shadowTriangles;
