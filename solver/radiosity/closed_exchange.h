@@ -44,6 +44,11 @@ bool OverlappingClosed(const Hierarchy& hierarchy, std::uint32_t r, std::uint32_
 std::vector<NodeLink> OverlappingClosedLinks(const NodeModel& model, std::uint32_t r,
                                              std::uint32_t s, double visibility);
 
+// Per direction ω of the set (the way the light goes): the box's mean optical depth along
+// it, −ln τ(ω) over its section A⊥ (for which ∫ e dℓ is 1 / A⊥ on the mean), τ taken at
+// least 0.05. ClosedNode::heldDepth, which HeldAroundLinks requires.
+std::vector<double> HeldDepths(const ClosedNode& node, const DirectionSet& directions);
+
 // The links s → r from a closed instance held from outside (ClosedNode::held) into organs r
 // whose bounds overlap its own: r lies among its leaves, and their light arrives from all
 // around, not from its centre. One link per direction bin ω of its light: a structure whose
@@ -64,11 +69,6 @@ std::vector<NodeLink> OverlappingClosedLinks(const NodeModel& model, std::uint32
 // the organs ahead of it (their optical depth from τ(ω)); and `passed` looks as far as a
 // point spread over the organs behind, not their centre: 2.13 % off before those three,
 // 1.89 % with them.
-// Per direction ω of the set (the way the light goes): the box's mean optical depth along
-// it, −ln τ(ω) over its section A⊥ (for which ∫ e dℓ is 1 / A⊥ on the mean), τ taken at
-// least kLeastTransmittance. ClosedNode::heldDepth.
-std::vector<double> HeldDepths(const ClosedNode& node, const DirectionSet& directions);
-
 std::vector<NodeLink> HeldAroundLinks(
     const NodeModel& model, std::uint32_t r, std::uint32_t s,
     const std::function<double(const Hierarchy::Point&, const glm::dvec3&, double)>& passed,
