@@ -140,7 +140,9 @@ def main():
     scenes += [("copies", args.copies_leaves * int(t), int(t),
                 lambda t=int(t): copies_plantation(leaflux, args.out, t, args.copies_leaves))
                for t in args.copies.split(",") if t]
-    most_leaves = {"instanced-tau": args.tau_leaves, "hrc": args.hrc_leaves, "mc": args.mc_leaves}
+    # solver: (the option bounding its scenes, the most leaves it runs on)
+    most_leaves = {"instanced-tau": ("--tau-leaves", args.tau_leaves), "hrc": ("--hrc-leaves", args.hrc_leaves),
+                   "mc": ("--mc-leaves", args.mc_leaves)}
     rows = []
     run_scenes = {(series, leaves) for series, leaves, _, _ in scenes}
     rows += [r for (series, leaves, _), r in kept.items() if (series, leaves) not in run_scenes]
@@ -154,8 +156,8 @@ def main():
                 continue
             setting, options = SOLVERS[solver](args, database)
             row = dict(series=series, leaves=leaves, trees=trees, solver=solver, setting=setting)
-            if leaves > most_leaves.get(solver, leaves):
-                row.update(status=f"not run (over --{solver.split('-')[-1]}-leaves {most_leaves[solver]})")
+            if solver in most_leaves and leaves > most_leaves[solver][1]:
+                row.update(status="not run (over {} {})".format(*most_leaves[solver]))
                 rows.append(row)
                 continue
             try:

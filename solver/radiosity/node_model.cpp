@@ -23,6 +23,10 @@ NodeModel::NodeModel(Hierarchy& hierarchy, const Scene& scene, const RayScene& r
       channels_(channels),
       bins_(directions.Size()),
       maxSubdivision_(maxSubdivision) {
+    axes_.resize(3 * static_cast<std::size_t>(bins_));
+    for (int d = 0; d < bins_; ++d) {
+        for (int a = 0; a < 3; ++a) axes_[a * bins_ + d] = directions_.Direction(d)[a];
+    }
     FindOrgans();
     FindOnward(scene);
     FindInnerSides(scene);
@@ -180,10 +184,6 @@ void NodeModel::FindPlanes() {
 // to 1.49 %) and from 0.45 to 0.37 % at level 3. What is left of the lobe's error is in its
 // shape between directions.
 void NodeModel::ScaleLobes() {
-    axes_.resize(3 * static_cast<std::size_t>(bins_));
-    for (int d = 0; d < bins_; ++d) {
-        for (int a = 0; a < 3; ++a) axes_[a * bins_ + d] = directions_.Direction(d)[a];
-    }
     lobeScale_.assign(flat_.triangles.size(), {1.0, 1.0});
     tbb::parallel_for(std::size_t{0}, flat_.triangles.size(), [&](std::size_t t) {
         std::array<double, 2> integral{};
