@@ -83,6 +83,7 @@ class InstancedSolve {
             }
         }
         std::sort(organReceiver_.begin(), organReceiver_.end());
+        if (shadows_ != nullptr) shadowTriangles_ = ShadowTriangles();
         out_.solution.light.assign(receivers.receivers.size(), scene.bands.size());
         out_.solution.balance.assign(scene.bands.size(), EnergyBalance{});
         out_.solution.unsolved.assign(receivers.receivers.size(), 0);
@@ -208,9 +209,9 @@ class InstancedSolve {
     bool Opens(std::uint32_t q, const glm::dmat4& worldFromRoot) const;
     // Closed instance c of `level` solved whole from the light that arrived on it.
     void SolveWhole(const Level& level, const LevelSolution& light, std::size_t c);
-    // Where the organs of part q and of the parts in it lie in the shadow engine
-    // (ClosedNode::shadowTriangles).
-    void ShadowTriangles(std::uint32_t q, ClosedNode& closed) const;
+    // Where the organs of each part and of the parts in it lie in the shadow engine
+    // (ClosedNode::shadowTriangles), by part.
+    std::vector<std::shared_ptr<const RayScene::TriangleRanges>> ShadowTriangles() const;
     // Counts the organs of part q and of the parts in it, and their area, into `whole`;
     // marks them unsolved, or pushed down (InstancedOptions::pushDown).
     void MarkUnsolved(std::uint32_t q, StructureLight& whole);
@@ -225,6 +226,8 @@ class InstancedSolve {
     const FlatScene& receivers_;
     const RayScene* const shadows_;
     SunMaps sunMaps_;  // over shadows_, when it is given
+    // Each part's organs in shadows_, when it is given (ShadowTriangles).
+    std::vector<std::shared_ptr<const RayScene::TriangleRanges>> shadowTriangles_;
     const InstanceTree& tree_;
     const SceneOriginals& originals_;
     const InstancedOptions options_;  // directOnly: holdOutside off (DirectOnlyAlone)
@@ -287,7 +290,7 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
         closed.areaM2 = instance.leafAreaM2;
         closed.organArea = instance.area;
         closed.opens = Opens(q, level->worldFromClosed[j]);
-        ShadowTriangles(q, closed);
+        if (shadows_ != nullptr) closed.shadowTriangles = shadowTriangles_[q];
         const std::shared_ptr<const Original>& original =
             originals_.bySignature.at(instance.signature);
         closed.contents = std::make_shared<OriginalContents>(
@@ -572,32 +575,38 @@ bool InstancedSolve::Opens(std::uint32_t q, const glm::dmat4& worldFromRoot) con
            (scene_.nodes[tree_[q].rootIndex].type != type && tree_.HoldsNodeOf(scene_, q, type));
 }
 
-void InstancedSolve::ShadowTriangles(std::uint32_t q, ClosedNode& closed) const {
-    RayScene::TriangleRanges ranges;
-    std::vector<std::uint32_t> parts = {q};
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-        for (std::size_t i : tree_[parts[k]].nodes) {
+std::vector<std::shared_ptr<const RayScene::TriangleRanges>> InstancedSolve::ShadowTriangles()
+    const {
+    // From the last part up, each part's instances coming after it: its own organs' ranges
+    // and its instances', merged. Found for each part as its level was built, each node was
+    // looked up once for every instance it lies in.
+    std::vector<std::shared_ptr<const RayScene::TriangleRanges>> own(tree_.Parts().size());
+    for (std::size_t q = own.size(); q-- > 1;) {
+        const InstanceTree::Part& part = tree_[static_cast<std::uint32_t>(q)];
+        RayScene::TriangleRanges ranges;
+        for (std::size_t i : part.nodes) {
             const std::uint32_t global = OrganReceiver(scene_.nodes[i].id);
             if (global == kNoReceiver) continue;
             const Receiver& r = receivers_.receivers[global];
             if (r.triangleCount > 0)
                 ranges.push_back({r.firstTriangle, r.firstTriangle + r.triangleCount});
         }
-        const auto& inner = tree_[parts[k]].instances;
-        parts.insert(parts.end(), inner.begin(), inner.end());
-    }
-    std::sort(ranges.begin(), ranges.end());
-    RayScene::TriangleRanges merged;
-    for (const auto& range : ranges) {
-        if (!merged.empty() && range[0] <= merged.back()[1]) {
-            merged.back()[1] = std::max(merged.back()[1], range[1]);
-        } else {
-            merged.push_back(range);
+        for (std::uint32_t inner : part.instances) {
+            if (own[inner]) ranges.insert(ranges.end(), own[inner]->begin(), own[inner]->end());
         }
+        std::sort(ranges.begin(), ranges.end());
+        RayScene::TriangleRanges merged;
+        for (const auto& range : ranges) {
+            if (!merged.empty() && range[0] <= merged.back()[1]) {
+                merged.back()[1] = std::max(merged.back()[1], range[1]);
+            } else {
+                merged.push_back(range);
+            }
+        }
+        if (!merged.empty())
+            own[q] = std::make_shared<const RayScene::TriangleRanges>(std::move(merged));
     }
-    if (!merged.empty())
-        closed.shadowTriangles =
-            std::make_shared<const RayScene::TriangleRanges>(std::move(merged));
+    return own;
 }
 
 void InstancedSolve::MarkUnsolved(std::uint32_t q, StructureLight& whole) {
