@@ -1,6 +1,6 @@
-// WorldFrames and ForEachWorldFrame: every node's frame in the world is the product of its
-// ancestors' frames, whatever the order of the nodes and their ids; nodes whose parent
-// links loop or lead nowhere have none.
+// WorldFrames, ForEachWorldFrame and ForEachFrameUnder: every node's frame in the world is
+// the product of its ancestors' frames, whatever the order of the nodes and their ids;
+// nodes whose parent links loop or lead nowhere have none.
 #include "solver/scene/world_frames.h"
 
 #include <gtest/gtest.h>
@@ -95,6 +95,35 @@ TEST(WorldFrames, AWalkVisitsEachNodeOnceAfterItsParentWithItsFrame) {
     });
     EXPECT_EQ(visited.size(), scene.nodes.size() - 1);
     EXPECT_FALSE(visited.count(90001));
+}
+
+// A subtree walked in its root's own frame, then placed by the root's frame in the world,
+// is where the world walk puts it: the frames compose (an instance's and its placement's).
+TEST(WorldFrames, ASubtreeInItsRootsFramePlacedByTheRootsIsInTheWorld) {
+    Scene scene;
+    TreeParameters tree;
+    tree.leafCount = 60;
+    AddTree(scene, tree, {1.0, 2.0, 0.0});
+    const WorldFrames frames(scene);
+    const Topology topology(scene);
+    // A node halfway down: an axis with nodes under it, not the root.
+    std::size_t root = 0;
+    for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
+        if (topology.Parent(i) != Topology::kNone && topology.Children(i).size() >= 2) root = i;
+    }
+    ASSERT_NE(root, 0u);
+    const glm::dmat4 worldFromRoot = frames.at(scene.nodes[root].id);
+    std::size_t visited = 0;
+    ForEachFrameUnder(scene, topology, root, glm::dmat4(1.0),
+                      [&](const Node& node, const glm::dmat4& rootFromNode) {
+                          if (visited++ == 0) {
+                              EXPECT_EQ(node.id, scene.nodes[root].id);
+                              ExpectFrame(rootFromNode, glm::dmat4(1.0), 0.0, node.id);
+                          }
+                          ExpectFrame(worldFromRoot * rootFromNode, frames.at(node.id), 1e-12,
+                                      node.id);
+                      });
+    EXPECT_GE(visited, 3u);
 }
 
 TEST(WorldFrames, NodesWhoseParentLinksLoopOrLeadNowhereHaveNone) {

@@ -68,14 +68,10 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
         return frame;
     };
     const auto walkOrgans = [&](const Part& part, const auto& visit) {
-        std::vector<std::pair<std::size_t, glm::dmat4>> walk{{part.rootIndex, glm::dmat4(1.0)}};
-        while (!walk.empty()) {
-            const auto [i, instanceFromNode] = walk.back();
-            walk.pop_back();
-            if (scene.nodes[i].organ) visit(*scene.nodes[i].organ->mesh, instanceFromNode);
-            for (const std::size_t c : topology.Children(i))
-                walk.push_back({c, instanceFromNode * glm::dmat4(scene.nodes[c].parentFromLocal)});
-        }
+        ForEachFrameUnder(scene, topology, part.rootIndex, glm::dmat4(1.0),
+                          [&](const Node& node, const glm::dmat4& instanceFromNode) {
+                              if (node.organ) visit(*node.organ->mesh, instanceFromNode);
+                          });
     };
     // Each part walks its own subtree, the parts at once: every level of them walks the
     // whole scene again.

@@ -36,7 +36,7 @@ NodeFacts FactsOf(const Scene& scene, bool inclination) {
     LEAFLUX_CHECK(order.size() == n);  // a validated scene is a forest
     NodeFacts facts{std::vector<std::int64_t>(n, 0), std::vector<double>(inclination ? n : 0, 0.0)};
     if (inclination) {
-        ForEachWorldFrame(scene, [&](const Node& node, const glm::dmat4& worldFromLocal) {
+        ForEachWorldFrame(scene, topology, [&](const Node& node, const glm::dmat4& worldFromLocal) {
             const glm::dvec3 z(worldFromLocal[2]);
             const double length = glm::length(z);
             facts.inclination[&node - scene.nodes.data()] =

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "solver/scene/scene.h"
+#include "solver/scene/topology.h"
 
 namespace leaflux {
 
@@ -36,6 +37,16 @@ class WorldFrames {
 // node for the walk (Topology), where WorldFrames keeps 136. Nodes whose parent links loop
 // or lead to no node are not visited.
 void ForEachWorldFrame(const Scene& scene,
+                       const std::function<void(const Node&, const glm::dmat4&)>& visit);
+// The same over the scene's topology, when the caller has it.
+void ForEachWorldFrame(const Scene& scene, const Topology& topology,
+                       const std::function<void(const Node&, const glm::dmat4&)>& visit);
+// Each node of the subtree under node `root` (its index in Scene::nodes), in the same
+// order, with its frame in the one `rootFrame` is given in: the root's is rootFrame, each
+// node's below it its parent's times its parentFromLocal. The identity gives the frames
+// in the root's own frame (an instance's).
+void ForEachFrameUnder(const Scene& scene, const Topology& topology, std::size_t root,
+                       const glm::dmat4& rootFrame,
                        const std::function<void(const Node&, const glm::dmat4&)>& visit);
 
 // worldFromLocal of every node, by id. Requires a validated scene (no cycles).
