@@ -30,7 +30,7 @@ namespace {
 
 // Bumped whenever the Monte Carlo solver's answer for a given seed changes, so that old
 // cached references are not taken for new ones.
-constexpr std::uint64_t kReferenceVersion = 1;
+constexpr std::uint64_t kReferenceVersion = 2;
 constexpr char kCacheMagic[8] = {'L', 'F', 'X', 'R', 'E', 'F', '0', '1'};
 
 // FNV-1a, 64 bits: stable across compilers and runs, unlike std::hash.

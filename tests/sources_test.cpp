@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 #include <glm/gtc/constants.hpp>
 
 namespace leaflux {
@@ -85,6 +86,53 @@ TEST(Sky, ConesCoverTheHemisphereAndKeepTheHorizontalIrradiance) {
         EXPECT_GT(horizontal, 99.0);
     }
     EXPECT_EQ(Sky({SkyModel::kUniform, {1.0}, SkyDiscretization::kTurtle46}).Cones().size(), 46u);
+}
+
+// The turtle's 46 cells (a zenith cap and rings of 5, 10, 15 and 15 sectors, each ring a
+// band of cos θ 1/46 per sector wide, alternate rings turned by half a sector): each is
+// 2π/46 sr, and each cone points along the mean of ω over its cell, here summed over 2^20
+// points even in solid angle; under the CIE overcast sky, (1 + 2 cos θ) / 3 of the zenith,
+// its radiance is the mean over the cell, up to the factor common to all (the horizontal
+// irradiance kept).
+TEST(Sky, TurtleConesAreTheMeansOfTheirCells) {
+    const std::vector<SkyCone> cones =
+        Sky{SkyModel::kCieOvercast, {1.0}, SkyDiscretization::kTurtle46}.Cones();
+    ASSERT_EQ(cones.size(), 46u);
+    constexpr int kRings[] = {1, 5, 10, 15, 15};
+    const auto cellOf = [&](const glm::dvec3& d) {
+        const double above = (1.0 - d.z) * 46.0;
+        int first = 0;
+        for (int ring = 0; ring < 5; ++ring) {
+            const int count = kRings[ring];
+            if (above < first + count || ring == 4) {
+                double phi = std::atan2(d.y, d.x);
+                if (phi < 0.0) phi += 2.0 * kPi;
+                const double turn = 0.5 * (ring % 2);
+                return first + static_cast<int>(phi / (2.0 * kPi) * count + turn) % count;
+            }
+            first += count;
+        }
+        return -1;
+    };
+    constexpr int kPoints = 1 << 20;
+    std::vector<glm::dvec3> sum(46, glm::dvec3(0.0));
+    std::vector<double> radiance(46, 0.0);
+    std::vector<int> count(46, 0);
+    const double golden = kPi * (3.0 - std::sqrt(5.0));
+    for (int i = 0; i < kPoints; ++i) {
+        const double z = 1.0 - (i + 0.5) / kPoints, r = std::sqrt(1.0 - z * z);
+        const glm::dvec3 d(r * std::cos(golden * i), r * std::sin(golden * i), z);
+        const int c = cellOf(d);
+        sum[c] += d, radiance[c] += (1.0 + 2.0 * z) / 3.0, ++count[c];
+    }
+    const double scale = cones[0].radianceWm2Sr[0] / (radiance[0] / count[0]);
+    for (int c = 0; c < 46; ++c) {
+        EXPECT_NEAR(cones[c].solidAngleSr, 2.0 * kPi / 46.0, 1e-12) << c;
+        // The points' share of the cell is its solid angle within ~1e-3 (their discrepancy).
+        EXPECT_NEAR(count[c] * 46.0 / kPoints, 1.0, 2e-3) << c;
+        EXPECT_LT(glm::length(cones[c].direction - glm::normalize(sum[c])), 1e-4) << c;
+        EXPECT_NEAR(cones[c].radianceWm2Sr[0] / scale, radiance[c] / count[c], 1e-4) << c;
+    }
 }
 
 }  // namespace
