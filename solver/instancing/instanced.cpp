@@ -207,6 +207,8 @@ class InstancedSolve {
     // Whether part q, placed by worldFromRoot, is opened (InstancedOptions::maxDepth,
     // outputLevel, inView).
     bool Opens(std::uint32_t q, const glm::dmat4& worldFromRoot) const;
+    // Whether part q is opened but for the view: what the solve asks (maxDepth, outputLevel).
+    bool OpensAsked(std::uint32_t q) const;
     // Closed instance c of `level` solved whole from the light that arrived on it.
     void SolveWhole(const Level& level, const LevelSolution& light, std::size_t c);
     // Where the organs of each part and of the parts in it lie in the shadow engine
@@ -290,6 +292,7 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
         closed.areaM2 = instance.leafAreaM2;
         closed.organArea = instance.area;
         closed.opens = Opens(q, level->worldFromClosed[j]);
+        closed.relit = OpensAsked(q);
         if (shadows_ != nullptr) closed.shadowTriangles = shadowTriangles_[q];
         const std::shared_ptr<const Original>& original =
             originals_.bySignature.at(instance.signature);
@@ -561,11 +564,14 @@ std::vector<std::uint8_t> InstancedSolve::SolvedTriangles() const {
 }
 
 bool InstancedSolve::Opens(std::uint32_t q, const glm::dmat4& worldFromRoot) const {
+    if (!OpensAsked(q)) return false;
+    if (!options_.inView) return true;
+    const auto [low, high] = PlacedBounds(worldFromRoot, tree_[q].boxMin, tree_[q].boxMax);
+    return options_.inView(low, high);
+}
+
+bool InstancedSolve::OpensAsked(std::uint32_t q) const {
     if (options_.maxDepth > 0 && tree_[q].depth > options_.maxDepth) return false;
-    if (options_.inView) {
-        const auto [low, high] = PlacedBounds(worldFromRoot, tree_[q].boxMin, tree_[q].boxMax);
-        if (!options_.inView(low, high)) return false;
-    }
     if (!options_.outputLevel) return true;
     // Down to the smallest structures of the type that are instances; a structure of
     // another type (a plant, for light per axis) holding structures of the type that are

@@ -66,6 +66,12 @@ struct ClosedNode {
     // Opened once its level is solved: what leaves the scene from it is counted from its
     // organs (the energy balance), not from what its phase function sends.
     bool opens = false;
+    // Opened, or left closed by the view alone (InstancedOptions::inView): its organs take
+    // the suns and sky again, and its links from them set only what it scatters here, judged
+    // as any node's (refinement.cpp), where one solved whole takes as many rays as bring its
+    // structure's light within ε. The view does not count, so that the light of the
+    // instances opened does not depend on which others are.
+    bool relit = false;
 
     bool Held() const { return !held.empty(); }
 
