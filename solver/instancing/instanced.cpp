@@ -584,8 +584,8 @@ bool InstancedSolve::OpensAsked(std::uint32_t q) const {
 std::vector<std::shared_ptr<const RayScene::TriangleRanges>> InstancedSolve::ShadowTriangles()
     const {
     // From the last part up, each part's instances coming after it: its own organs' ranges
-    // and its instances', merged. Found for each part as its level was built, each node was
-    // looked up once for every instance it lies in.
+    // and its instances', merged. Each node is looked up once, not once for every instance
+    // it lies in, as finding them when each level is built would.
     std::vector<std::shared_ptr<const RayScene::TriangleRanges>> own(tree_.Parts().size());
     for (std::size_t q = own.size(); q-- > 1;) {
         const InstanceTree::Part& part = tree_[static_cast<std::uint32_t>(q)];

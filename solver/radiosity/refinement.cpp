@@ -195,7 +195,8 @@ Refiner::Verdict Refiner::JudgeSource(std::uint32_t r, std::uint32_t s) const {
     // (Instanced.PlantsSolvedWholeInEachOthersCrownsTakeTheirShade). One opened later
     // (ClosedNode::relit) takes the suns and sky again from its organs: its link sets only
     // what it scatters in this level, and is judged as any node's. On the 119k-triangle tree
-    // its extra rounds were 12 % of the time at ε = 1e-4, for an L2 error no lower.
+    // extra rounds for those would take 12 % more time at ε = 1e-4, for an L2 error no
+    // lower.
     if (const std::int32_t c = hierarchy_[r].closed;
         c >= 0 && !hierarchy_.Closed()[c].relit && error > threshold) {
         const int rays = visibility_.SourceRays(s);

@@ -55,8 +55,8 @@ void ForEachFrameUnder(const Scene& scene, const Topology& topology, std::size_t
                        const std::function<void(const Node&, const glm::dmat4&)>& visit) {
     // Depth first: the nodes to visit with their depths below the root, and the frame of
     // the last node visited at each depth, which is the parent's of the next node popped
-    // one deeper. A node waited on the stack with its frame, 136 bytes, where it now waits
-    // with 8: on the 119k-triangle tree the walk took 11 ms, now 4.
+    // one deeper. A waiting node takes 8 bytes, not its frame's 136: on the 119k-triangle
+    // tree the walk takes 4 ms, where carrying the frames took 11.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{
         {static_cast<std::uint32_t>(root), 0}};
     std::vector<glm::dmat4> frames{rootFrame};
