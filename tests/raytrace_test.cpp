@@ -86,6 +86,20 @@ TEST(RayScene, AnOcclusionQueryPassesTheTrianglesItSkips) {
         EXPECT_EQ(RayScene::InRanges(apart, t), t < 2 || (t >= 4 && t < 6)) << t;
 }
 
+// Ranges in any order, overlapping or touching, merge into the sorted, disjoint ranges
+// of the same triangles.
+TEST(RayScene, RangesMergeIntoTheSameTrianglesSortedAndDisjoint) {
+    const RayScene::TriangleRanges ranges{{7, 10}, {0, 2}, {5, 8}, {2, 3}, {12, 13}, {8, 9}};
+    const RayScene::TriangleRanges merged = RayScene::Merged(ranges);
+    EXPECT_EQ(merged, (RayScene::TriangleRanges{{0, 3}, {5, 10}, {12, 13}}));
+    for (std::uint32_t t = 0; t < 15; ++t) {
+        bool in = false;
+        for (const auto& range : ranges) in = in || (t >= range[0] && t < range[1]);
+        EXPECT_EQ(RayScene::InRanges(merged, t), in) << t;
+    }
+    EXPECT_TRUE(RayScene::Merged({}).empty());
+}
+
 TEST(RayScene, OccludedAmongMeetsOnlyTheTrianglesListed) {
     // Three plates stacked 1 m apart, two triangles each: a ray up from below meets the
     // listed ones alone, within its length; the corners are the plates'.

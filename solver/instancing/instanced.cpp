@@ -600,17 +600,10 @@ std::vector<std::shared_ptr<const RayScene::TriangleRanges>> InstancedSolve::Sha
         for (std::uint32_t inner : part.instances) {
             if (own[inner]) ranges.insert(ranges.end(), own[inner]->begin(), own[inner]->end());
         }
-        std::sort(ranges.begin(), ranges.end());
-        RayScene::TriangleRanges merged;
-        for (const auto& range : ranges) {
-            if (!merged.empty() && range[0] <= merged.back()[1]) {
-                merged.back()[1] = std::max(merged.back()[1], range[1]);
-            } else {
-                merged.push_back(range);
-            }
+        if (!ranges.empty()) {
+            own[q] = std::make_shared<const RayScene::TriangleRanges>(
+                RayScene::Merged(std::move(ranges)));
         }
-        if (!merged.empty())
-            own[q] = std::make_shared<const RayScene::TriangleRanges>(std::move(merged));
     }
     return own;
 }

@@ -106,6 +106,19 @@ class RayScene {
                   std::vector<std::uint8_t>& occluded) const;
     // Triangles as sorted, disjoint ranges [from, to) of their indices.
     using TriangleRanges = std::vector<std::array<std::uint32_t, 2>>;
+    // Ranges in any order, overlapping or touching, as such: sorted, those that meet merged.
+    static TriangleRanges Merged(TriangleRanges ranges) {
+        std::sort(ranges.begin(), ranges.end());
+        TriangleRanges merged;
+        for (const auto& range : ranges) {
+            if (!merged.empty() && range[0] <= merged.back()[1]) {
+                merged.back()[1] = std::max(merged.back()[1], range[1]);
+            } else {
+                merged.push_back(range);
+            }
+        }
+        return merged;
+    }
     static bool InRanges(const TriangleRanges& ranges, std::uint32_t triangle) {
         const auto after = std::upper_bound(
             ranges.begin(), ranges.end(), triangle,
