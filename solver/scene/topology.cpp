@@ -13,7 +13,7 @@ Topology::Topology(const Scene& scene) {
     {
         std::vector<std::pair<NodeId, std::uint32_t>> byId(n);
         for (std::uint32_t i = 0; i < n; ++i) byId[i] = {scene.nodes[i].id, i};
-        // Scenes as read are in id order (ExpandPlacements, the importers): no sort then.
+        // Often in id order already (ExpandPlacements leaves them so): no sort then.
         if (!std::is_sorted(byId.begin(), byId.end())) std::sort(byId.begin(), byId.end());
         for (std::uint32_t i = 0; i < n; ++i) {
             const NodeId parent = scene.nodes[i].parent;

@@ -70,7 +70,7 @@ struct CellIntegration {
 // F(z) = (z √(1 − z²) + asin z) / 2; a sky model's mean radiance over it is the model's at
 // the ring's mean z, the models being linear in z alone (uniform, CIE overcast). The 2^18
 // points of the integration the other discretisations take had the cells' solid angles
-// within 1e-4 and cost 20 ms of every process that lit a scene under a sky.
+// within 4e-4 and cost about 20 ms of every process that lit a scene under a sky.
 void IntegrateTurtle(std::vector<SkyCell>& cells, std::vector<double>& radiance,
                      const std::span<const Sky> unitSkies) {
     const auto F = [](double z) { return 0.5 * (z * std::sqrt(1.0 - z * z) + std::asin(z)); };
