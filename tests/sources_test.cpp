@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <vector>
 #include <glm/gtc/constants.hpp>
+#include <vector>
 
 namespace leaflux {
 namespace {

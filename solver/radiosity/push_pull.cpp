@@ -292,6 +292,8 @@ void PushPull::PushDown(const Links& links, const Gathered& gathered, const Sour
             if constexpr (kDirections) {
                 glm::dvec3 moment(0.0);
                 for (int d = 0; d < bins; ++d) {
+                    // The side facing d: the upper lobe is positive exactly there (each
+                    // side's lobe scale is positive, ScaleLobes).
                     if (inner[upper[d] > 0.0 ? kUpper : kLower]) continue;
                     const double normal = sum[d * channels + k];
                     in.Integral()[k] += normal;
