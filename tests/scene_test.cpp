@@ -300,6 +300,38 @@ TEST(Frame, KeepsTheTranslationExactAndTheRotationInSinglePrecision) {
     EXPECT_EQ(glm::dmat4(Frame()), glm::dmat4(1.0));
 }
 
+TEST(Scene, NamesTheFirstFailingOrganInTheNodesOrder) {
+    // The organs' meshes are checked where they are placed, walking down from the roots, and
+    // their names apart: of several failing, the error names the first in the nodes' order,
+    // whichever the walk meets first. Leaf 3 comes first but hangs from plant 1, a root the
+    // walk takes after leaf 4, a root before it.
+    const std::shared_ptr<const Mesh> flat =
+        MeshWith({{0, 0, 0}, {1, 0, 0}, {2, 0, 0}}, {{0, 1, 2}});  // no area
+    const auto errorOf = [](const Scene& scene) -> std::pair<ErrorCode, std::optional<NodeId>> {
+        try {
+            scene.Validate();
+        } catch (const InputError& e) {
+            return {e.Code(), e.Node()};
+        }
+        ADD_FAILURE() << "no error";
+        return {};
+    };
+    Scene scene = ValidScene();
+    scene.nodes.erase(scene.nodes.begin() + 1);  // the plant alone
+    scene.nodes.insert(scene.nodes.begin(), OrganNode(4, "leaf4", flat, "leaf"));
+    scene.nodes.insert(scene.nodes.begin(), OrganNode(3, "leaf3", flat, "leaf", 1));
+    EXPECT_EQ(errorOf(scene), std::pair(ErrorCode::kDegenerate, std::optional<NodeId>(3)));
+    // Leaf 3 whole again and leaf 5 named as leaf 4: leaf 4's mesh comes before the name.
+    scene.nodes[0].organ->mesh = Rectangle(0.1, 0.05, 1.0);
+    scene.nodes.push_back(OrganNode(5, "leaf4", Rectangle(0.1, 0.05, 2.0), "leaf"));
+    EXPECT_EQ(errorOf(scene), std::pair(ErrorCode::kDegenerate, std::optional<NodeId>(4)));
+    // Leaf 4 whole: the name.
+    scene.nodes[1].organ->mesh = Rectangle(0.1, 0.05, 3.0);
+    EXPECT_EQ(errorOf(scene), std::pair(ErrorCode::kAlreadyExists, std::optional<NodeId>(5)));
+    scene.nodes[3].name = "leaf5";
+    EXPECT_NO_THROW(scene.Validate());
+}
+
 TEST(Scene, WorldFromLocalComposesParentsFirst) {
     Scene scene = ValidScene();
     scene.nodes[0].parentFromLocal =

@@ -5,10 +5,10 @@
 #include <cstdio>
 #include <set>
 #include <type_traits>
-#include <unordered_map>
 #include <unordered_set>
 
 #include "solver/scene/light_units.h"
+#include "solver/scene/topology.h"
 #include "solver/scene/world_frames.h"
 #include "solver/util/error.h"
 
@@ -79,50 +79,124 @@ void RequireOptics(const Scene& scene, const std::string& id, const std::string&
         throw InputError(ErrorCode::kNotFound, field, "names unknown optics '" + id + "'", node);
 }
 
-void ValidateTopology(const Scene& scene, std::set<std::string>& names) {
-    std::unordered_map<NodeId, const Node*> byId;
-    byId.reserve(scene.nodes.size());
-    for (const Node& node : scene.nodes) {
-        if (!byId.emplace(node.id, &node).second) {
+// The names receivers answer to, which must differ: the organs' (Scene::NodeName), held as
+// their hashes and node indices in hash order, 16 bytes an organ (a std::set of the names
+// took about 100, on a plantation of 233 trees 190 MB), and the few surfaces' and
+// emitters' in a set.
+class ReceiverNames {
+  public:
+    explicit ReceiverNames(const Scene& scene) : scene_(scene) {
+        for (std::uint32_t i = 0; i < scene.nodes.size(); ++i) {
+            if (scene.nodes[i].organ) organs_.push_back({Hash(scene.NodeName(scene.nodes[i])), i});
+        }
+        std::sort(organs_.begin(), organs_.end());
+    }
+    // The first organ, in the nodes' order, whose name an organ before it has; none if all
+    // differ.
+    std::optional<std::size_t> FirstRepeated() const {
+        std::optional<std::size_t> first;
+        for (std::size_t a = 0; a < organs_.size();) {
+            std::size_t b = a + 1;
+            while (b < organs_.size() && organs_[b].first == organs_[a].first) ++b;
+            // Equal hashes, in index order: names compared (a hash may be shared).
+            for (std::size_t k = a + 1; k < b; ++k) {
+                const std::string name = NameOf(k);
+                for (std::size_t e = a; e < k; ++e) {
+                    if (NameOf(e) == name && (!first || organs_[k].second < *first)) {
+                        first = organs_[k].second;
+                        break;
+                    }
+                }
+            }
+            a = b;
+        }
+        return first;
+    }
+    // Takes a surface's or emitter's name; false when an organ or another receiver has it.
+    bool Insert(const std::string& name) {
+        const std::uint64_t hash = Hash(name);
+        for (auto at = std::lower_bound(organs_.begin(), organs_.end(), std::pair{hash, 0u});
+             at != organs_.end() && at->first == hash; ++at) {
+            if (NameOf(static_cast<std::size_t>(at - organs_.begin())) == name) return false;
+        }
+        return others_.insert(name).second;
+    }
+
+  private:
+    static std::uint64_t Hash(const std::string& name) { return std::hash<std::string>{}(name); }
+    std::string NameOf(std::size_t k) const {
+        return scene_.NodeName(scene_.nodes[organs_[k].second]);
+    }
+
+    const Scene& scene_;
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> organs_;
+    std::set<std::string> others_;
+};
+
+// Ids, parents, cycles, organ meshes and names, in memory that grows by some 30 bytes a node
+// at its peak (the scene's Topology): hash maps of the nodes by id and of the ids rooted,
+// with every node's world frame kept, took about 230 bytes a node (on the 4.3 M nodes of
+// the paper's plantation, more than the scene itself). Each check reports the first node
+// in the nodes' order that fails it.
+void ValidateTopology(const Scene& scene, ReceiverNames& names) {
+    {
+        std::vector<NodeId> ids(scene.nodes.size());
+        for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = scene.nodes[i].id;
+        std::sort(ids.begin(), ids.end());
+        // The id used twice that the nodes' order meets second first.
+        std::optional<std::size_t> repeated;
+        if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) {
+            std::unordered_set<NodeId> seen;
+            for (std::size_t i = 0; i < scene.nodes.size() && !repeated; ++i) {
+                if (!seen.insert(scene.nodes[i].id).second) repeated = i;
+            }
+        }
+        if (repeated) {
             throw InputError(ErrorCode::kAlreadyExists, "nodes.id", "the id is used by two nodes",
-                             node.id);
+                             scene.nodes[*repeated].id);
         }
     }
-    for (const Node& node : scene.nodes) {
+    const Topology topology(scene);
+    for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
+        const Node& node = scene.nodes[i];
         ValidateNode(scene, node);
-        if (node.parent != kNoParent && !byId.count(node.parent)) {
+        if (node.parent != kNoParent && topology.Parent(i) == Topology::kNone) {
             throw InputError(ErrorCode::kNotFound, "parent",
                              "names unknown node " + std::to_string(node.parent), node.id);
         }
     }
-    // Cycles: walk up from each node; a walk longer than the node count loops.
-    std::unordered_set<NodeId> rooted;
-    for (const Node& node : scene.nodes) {
-        std::vector<NodeId> path;
-        NodeId at = node.id;
-        while (at != kNoParent && !rooted.count(at)) {
-            path.push_back(at);
-            if (path.size() > scene.nodes.size()) {
-                throw InputError(ErrorCode::kCycle, "parent", "the parent links of this node loop",
-                                 node.id);
-            }
-            at = byId.at(at)->parent;
+    // Cycles: every parent is a node, so a node the walk from the roots does not reach has
+    // parent links that loop above it. And the organs' meshes where they are placed: the
+    // first failing in the nodes' order is reported, as the names below.
+    std::vector<std::uint8_t> reached(scene.nodes.size(), 0);
+    std::optional<std::size_t> badMesh;
+    std::optional<InputError> meshError;
+    ForEachWorldFrame(scene, topology, [&](const Node& node, const glm::dmat4& worldFromLocal) {
+        const auto i = static_cast<std::size_t>(&node - scene.nodes.data());
+        reached[i] = 1;
+        if (!node.organ || (badMesh && *badMesh < i)) return;
+        try {
+            ValidateMesh(node.organ->mesh.get(), worldFromLocal, "organ.mesh", node.id);
+        } catch (const InputError& e) {
+            badMesh = i;
+            meshError.emplace(e);
         }
-        rooted.insert(path.begin(), path.end());
+    });
+    const auto loop = std::find(reached.begin(), reached.end(), 0);
+    if (loop != reached.end()) {
+        throw InputError(ErrorCode::kCycle, "parent", "the parent links of this node loop",
+                         scene.nodes[static_cast<std::size_t>(loop - reached.begin())].id);
     }
-    const auto worldFromLocal = WorldFromLocal(scene);
-    for (const Node& node : scene.nodes) {
-        if (!node.organ) continue;
-        ValidateMesh(node.organ->mesh.get(), worldFromLocal.at(node.id), "organ.mesh", node.id);
-        std::string name = scene.NodeName(node);
-        if (!names.insert(name).second) {
-            throw InputError(ErrorCode::kAlreadyExists, "name",
-                             "organ name '" + name + "' is used twice", node.id);
-        }
+    const std::optional<std::size_t> repeated = names.FirstRepeated();
+    if (badMesh && (!repeated || *badMesh <= *repeated)) throw *meshError;
+    if (repeated) {
+        const Node& node = scene.nodes[*repeated];
+        throw InputError(ErrorCode::kAlreadyExists, "name",
+                         "organ name '" + scene.NodeName(node) + "' is used twice", node.id);
     }
 }
 
-void ValidateSources(const Scene& scene, std::set<std::string>& names) {
+void ValidateSources(const Scene& scene, ReceiverNames& names) {
     for (std::size_t i = 0; i < scene.sources.suns.size(); ++i) {
         ValidateSun(scene, scene.sources.suns[i], "suns[" + std::to_string(i) + "]");
     }
@@ -138,7 +212,7 @@ void ValidateSources(const Scene& scene, std::set<std::string>& names) {
         RequirePerBand(scene, emitter.exitanceWm2, field + ".exitance");
         if (!emitter.opticsId.empty())
             RequireOptics(scene, emitter.opticsId, field + ".optics", {});
-        Require(names.insert(emitter.name).second, ErrorCode::kAlreadyExists, field + ".name",
+        Require(names.Insert(emitter.name), ErrorCode::kAlreadyExists, field + ".name",
                 "the name is used twice");
     }
 }
@@ -305,7 +379,7 @@ void Scene::Validate() const {
                     got);
     }
     ValidateOptics(*this);
-    std::set<std::string> names;
+    ReceiverNames names(*this);
     ValidateTopology(*this, names);
     for (std::size_t i = 0; i < environment.size(); ++i) {
         const Surface& surface = environment[i];
@@ -323,7 +397,7 @@ void Scene::Validate() const {
                     "' must have tau_upper = tau_lower = 0 (band " + bands[b].name + ")");
         }
         ValidateMesh(surface.mesh.get(), glm::dmat4(1.0), field + ".mesh", std::nullopt);
-        Require(names.insert(surface.name).second, ErrorCode::kAlreadyExists, field + ".name",
+        Require(names.Insert(surface.name), ErrorCode::kAlreadyExists, field + ".name",
                 "the name is used twice");
     }
     ValidateSources(*this, names);
