@@ -65,6 +65,15 @@ struct RayHit {
     RayStart next;  // the hit point as the start of the next ray (kHit only)
 };
 
+// A run of a RayScene's triangles: `count` triangles of `vertices` vertices of its own, or
+// (copyOf ≥ 0) those of the earlier run copyOf, moved by `moved` (in the engine's frame)
+// and numbered after the runs before it.
+struct RayRun {
+    std::uint32_t count = 0, vertices = 0;
+    std::int32_t copyOf = -1;
+    glm::dmat4 moved{1.0};
+};
+
 class RayScene {
   public:
     // `periodic`: the tile, in the FlatScene's local frame, repeated in x and y. Geometry
@@ -73,16 +82,17 @@ class RayScene {
     RayScene(const FlatScene& flat, std::optional<PeriodicDomain> periodic,
              std::shared_ptr<RayDevice> device = RayDevice::Shared(),
              std::uint32_t triangles = kNoTriangle);
-    // Over `triangles` triangles of `vertices` vertices that `place` writes, 3 floats a
-    // vertex in the frame of `frame` (origin, bounds; its triangles unused) and 3 vertex
-    // indices a triangle: the whole scene's triangles without a flat scene of them
-    // (PlaceVertices). Not periodic. `compact`: Embree's compact hierarchy, whose leaves
+    // Over runs of triangles, numbered one after the other (RayRun): each of its own, whose
+    // vertices (3 floats each, in the frame of `frame`: origin, bounds; its triangles
+    // unused) and triangles (3 indices into the run's vertices each) `place` writes, a
+    // buffer per run (null for a copy); or a copy of an earlier run, held as an Embree
+    // instance of it. Not periodic. `compact`: Embree's compact hierarchy, whose leaves
     // index the vertices instead of copying them: a lower peak for a slower solve (the
     // instanced-compact rows of docs/results.md, "Time and memory against size").
-    using PlaceMesh = std::function<void(float* xyz, std::uint32_t* indices)>;
-    RayScene(const FlatScene& frame, std::uint32_t triangles, std::uint32_t vertices,
-             const PlaceMesh& place, bool compact = false,
-             std::shared_ptr<RayDevice> device = RayDevice::Shared());
+    using PlaceRuns = std::function<void(const std::vector<float*>& xyz,
+                                         const std::vector<std::uint32_t*>& indices)>;
+    RayScene(const FlatScene& frame, std::vector<RayRun> runs, const PlaceRuns& place,
+             bool compact = false, std::shared_ptr<RayDevice> device = RayDevice::Shared());
     ~RayScene();
     RayScene(const RayScene&) = delete;
     RayScene& operator=(const RayScene&) = delete;
@@ -136,6 +146,7 @@ class RayScene {
                        const TriangleRanges& only) const;
     // The corners of triangle t, in the frame its rays are traced in (not periodic copies).
     std::array<glm::dvec3, 3> Corners(std::uint32_t t) const {
+        if (!runs_.empty()) return RunCorners(t);
         std::array<glm::dvec3, 3> corners;
         for (int k = 0; k < 3; ++k) {
             const float* v = xyz_ + 3 * static_cast<std::size_t>(indices_[3 * std::size_t{t} + k]);
@@ -158,9 +169,12 @@ class RayScene {
     bool Periodic() const { return periodic_.has_value(); }
 
   private:
-    void BuildMesh(std::size_t triangles, std::size_t vertices, const PlaceMesh& place,
-                   bool compact = false);
+    using PlaceMesh = std::function<void(float* xyz, std::uint32_t* indices)>;
+    void BuildMesh(std::size_t triangles, std::size_t vertices, const PlaceMesh& place);
     void BuildTop();  // the mesh, or its 9 periodic copies
+    std::array<glm::dvec3, 3> RunCorners(std::uint32_t t) const;
+    // What the filter reads to number a hit: each run's first triangle (null: one mesh).
+    const std::uint32_t* RunFirst() const { return runFirst_.empty() ? nullptr : runFirst_.data(); }
     template <class Direction>
     void OccludedAlong(const std::vector<RayStart>& starts, const Direction& direction,
                        bool coherent, std::vector<std::uint8_t>& occluded) const;
@@ -178,6 +192,18 @@ class RayScene {
     RTCScene top_ = nullptr;      // the triangles, or 9 instances of them in a periodic scene
     const float* xyz_ = nullptr;  // the triangles' vertices, 3 floats each
     const std::uint32_t* indices_ = nullptr;  // and their 3 vertex indices each
+    // Built from runs: each run's first triangle (by its geometry's id in top_, which the
+    // filter and hits read), its vertices and indices (its original's for a copy) and
+    // where a copy is moved to; the originals' scenes, which copies instance.
+    struct Run {
+        std::uint32_t first = 0;
+        const float* xyz = nullptr;
+        const std::uint32_t* indices = nullptr;
+        std::optional<glm::dmat4> moved;
+    };
+    std::vector<Run> runs_;
+    std::vector<std::uint32_t> runFirst_;
+    std::vector<RTCScene> originals_;
 };
 
 // The scene's triangles in a ray engine, numbered as Flatten numbers them, in the frame of
@@ -185,7 +211,10 @@ class RayScene {
 // exact shadows without a flat scene of the triangles in double precision. Its organs come
 // first; walls, roofs and the ground shade the organs and one another as in the flat
 // scene's engine (the organs alone, a room's leaves took the sky through its walls).
-// `compact`: as RayScene's.
+// `compact`: Embree's compact hierarchy (as RayScene's), and each plant that copies
+// another exactly (FindCopies) held as an instance of it, the two in one hierarchy: less
+// memory for a slower solve (rays cross two hierarchies where a copy is met, and a turned
+// copy's box is wider than its tree).
 std::unique_ptr<RayScene> SceneRays(const Scene& scene, const FlatScene& receivers,
                                     bool compact = false);
 

@@ -179,25 +179,39 @@ const Mesh& ReceiverMesh(const Scene& scene, const Receiver& receiver) {
 void PlaceVertices(const Scene& scene, const FlatScene& receivers, float* xyz,
                    std::uint32_t* indices) {
     const std::vector<Receiver>& all = receivers.receivers;
-    // Each receiver's first vertex; each organ's receiver by its node's index.
-    std::vector<std::uint32_t> firstVertex(all.size()), receiverOf(scene.nodes.size(), 0);
+    std::vector<std::uint32_t> firstVertex(all.size());  // each receiver's first vertex
     std::uint32_t vertices = 0;
     for (std::uint32_t r = 0; r < all.size(); ++r) {
-        if (all[r].kind == ReceiverKind::kOrgan) receiverOf[all[r].declared] = r;
         firstVertex[r] = vertices;
         vertices += static_cast<std::uint32_t>(ReceiverMesh(scene, all[r]).positions.size());
     }
+    PlaceVertices(scene, receivers, [&](std::uint32_t r) {
+        return VertexSlot{xyz + 3 * static_cast<std::size_t>(firstVertex[r]),
+                          indices + 3 * static_cast<std::size_t>(all[r].firstTriangle),
+                          firstVertex[r]};
+    });
+}
+
+void PlaceVertices(const Scene& scene, const FlatScene& receivers,
+                   const std::function<VertexSlot(std::uint32_t receiver)>& slot) {
+    const std::vector<Receiver>& all = receivers.receivers;
+    std::vector<std::uint32_t> receiverOf(scene.nodes.size(), 0);  // by node index
+    for (std::uint32_t r = 0; r < all.size(); ++r) {
+        if (all[r].kind == ReceiverKind::kOrgan) receiverOf[all[r].declared] = r;
+    }
     const auto put = [&](const Mesh& mesh, const glm::dmat4& worldFromLocal, std::uint32_t r) {
-        float* at = xyz + 3 * static_cast<std::size_t>(firstVertex[r]);
+        const VertexSlot to = slot(r);
+        if (!to.xyz) return;
+        float* at = to.xyz;
         for (const glm::dvec3& position : mesh.positions) {
             const glm::dvec3 local = Placed(worldFromLocal, position) - receivers.origin;
             *at++ = static_cast<float>(local.x);
             *at++ = static_cast<float>(local.y);
             *at++ = static_cast<float>(local.z);
         }
-        std::uint32_t* index = indices + 3 * static_cast<std::size_t>(all[r].firstTriangle);
+        std::uint32_t* index = to.indices;
         for (const glm::uvec3& triangle : mesh.triangles) {
-            for (int k = 0; k < 3; ++k) *index++ = firstVertex[r] + triangle[k];
+            for (int k = 0; k < 3; ++k) *index++ = to.firstVertex + triangle[k];
         }
     };
     // The organs by their world frames, not kept (ForEachWorldFrame); the others as declared.

@@ -75,6 +75,18 @@ const Mesh& ReceiverMesh(const Scene& scene, const Receiver& receiver);
 // each of ReceiverMesh's positions, `indices` 3 for each triangle.
 void PlaceVertices(const Scene& scene, const FlatScene& receivers, float* xyz,
                    std::uint32_t* indices);
+// Where PlaceVertices puts a receiver's vertices (3 floats each, from xyz) and its
+// triangles' (3 vertex indices each, from indices, counted from firstVertex); nowhere when
+// xyz is null.
+struct VertexSlot {
+    float* xyz = nullptr;
+    std::uint32_t* indices = nullptr;
+    std::uint32_t firstVertex = 0;
+};
+// PlaceVertices with each receiver put where `slot` says: several buffers, or some
+// receivers not at all (a ray engine's runs, RayScene).
+void PlaceVertices(const Scene& scene, const FlatScene& receivers,
+                   const std::function<VertexSlot(std::uint32_t receiver)>& slot);
 
 // A mesh's triangles placed by worldFromLocal, in world coordinates (receiver 0).
 std::vector<Triangle> PlaceMesh(const Mesh& mesh, const glm::dmat4& worldFromLocal);
