@@ -71,5 +71,28 @@ TEST(Attributes, CopiesAreValues) {
     EXPECT_EQ(none.count("height"), 0u);
 }
 
+TEST(Attributes, CopiesShareTheirEntriesUntilOneChanges) {
+    Attributes original;
+    original["length_m"] = 0.1;
+    const Attributes copy = original;  // shared, as a placed structure's nodes are
+    Attributes changed = original;
+    changed["length_m"] = 0.2;
+    changed["order"] = 1;
+    EXPECT_EQ(original.at("length_m"), 0.1);
+    EXPECT_EQ(copy.at("length_m"), 0.1);
+    EXPECT_EQ(original.size(), 1u);
+    EXPECT_EQ(changed.at("length_m"), 0.2);
+    EXPECT_EQ(changed.size(), 2u);
+    EXPECT_EQ(copy, original);
+    // Moved and assigned away, the others keep their entries.
+    Attributes moved = std::move(changed);
+    original = moved;
+    EXPECT_EQ(original.at("order"), 1.0);
+    EXPECT_EQ(copy.at("length_m"), 0.1);
+    original = Attributes();
+    EXPECT_TRUE(original.empty());
+    EXPECT_EQ(moved.size(), 2u);
+}
+
 }  // namespace
 }  // namespace leaflux

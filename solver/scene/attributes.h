@@ -1,10 +1,14 @@
 // A node's named numbers (OPF's attributes, a growth model's): a few a node, kept sorted by
-// name in one block, held by pointer so that a node without any (most of a generated
-// plantation's) pays 8 bytes. A std::map cost 48 bytes a node and about 80 an entry, a
-// std::vector in place 24.
+// name in one block, held by pointer so that a node without any pays 8 bytes. A std::map
+// cost 48 bytes a node and about 80 an entry, a std::vector in place 24. The block is shared
+// by copies until one of them changes (copy on write): the nodes of placed structures
+// (leaflux.v1.Scene.placements) share their structure's, where each of the paper's
+// plantation's 1.9 M leaves held a block of its own (about 100 bytes, 190 MB in all).
 #pragma once
 
 #include <algorithm>
+#include <atomic>
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -20,16 +24,22 @@ class Attributes {
     using const_iterator = std::vector<value_type>::const_iterator;
 
     Attributes() = default;
-    Attributes(const Attributes& other)
-        : entries_(other.entries_ ? std::make_unique<Entries>(*other.entries_) : nullptr) {}
-    Attributes(Attributes&&) noexcept = default;
+    Attributes(const Attributes& other) : block_(other.block_) {
+        if (block_) block_->holders.fetch_add(1, std::memory_order_relaxed);
+    }
+    Attributes(Attributes&& other) noexcept : block_(std::exchange(other.block_, nullptr)) {}
     Attributes& operator=(const Attributes& other) {
         if (this != &other) *this = Attributes(other);
         return *this;
     }
-    Attributes& operator=(Attributes&&) noexcept = default;
+    Attributes& operator=(Attributes&& other) noexcept {
+        std::swap(block_, other.block_);
+        return *this;
+    }
+    ~Attributes() { Release(); }
 
-    // The value named so, made 0 if absent (as std::map's).
+    // The value named so, made 0 if absent (as std::map's). The reference is good until the
+    // attributes are next copied (the copy shares what it refers to).
     double& operator[](std::string_view name) {
         Entries& entries = Made();
         const auto at = LowerBound(entries.begin(), entries.end(), name);
@@ -65,13 +75,29 @@ class Attributes {
 
   private:
     using Entries = std::vector<value_type>;
+    struct Block {
+        std::atomic<std::uint32_t> holders{1};
+        Entries entries;
+    };
     const Entries& Held() const {
         static const Entries none;
-        return entries_ ? *entries_ : none;
+        return block_ ? block_->entries : none;
     }
+    // The entries to change: a block of this node's own, copied from the shared one.
     Entries& Made() {
-        if (!entries_) entries_ = std::make_unique<Entries>();
-        return *entries_;
+        if (!block_) {
+            block_ = new Block;
+        } else if (block_->holders.load(std::memory_order_acquire) > 1) {
+            Block* own = new Block;
+            own->entries = block_->entries;
+            Release();
+            block_ = own;
+        }
+        return block_->entries;
+    }
+    void Release() {
+        if (block_ && block_->holders.fetch_sub(1, std::memory_order_acq_rel) == 1) delete block_;
+        block_ = nullptr;
     }
     // Where `name` is, or would go.
     template <class Iterator>
@@ -80,7 +106,7 @@ class Attributes {
             first, last, name, [](const value_type& e, std::string_view n) { return e.first < n; });
     }
 
-    std::unique_ptr<Entries> entries_;  // null: none
+    Block* block_ = nullptr;  // null: none
 };
 
 }  // namespace leaflux
