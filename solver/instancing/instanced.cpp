@@ -98,8 +98,10 @@ class InstancedSolve {
 
     void Run() {
         if (shadows_ != nullptr) DrawSuns();
+        organsProjected_ = OrgansProjectedAreas();
         const std::unique_ptr<Level> top = Build(InstanceTree::kTop, glm::dmat4(1.0), nullptr, 0);
         LevelSolution light = Solve(InstanceTree::kTop, *top, {});
+        organsProjected_ = {};
         if (options_.hrc.directOnly) {
             held_ = Lamps();
         } else if (!options_.holdOutside) {
@@ -113,18 +115,23 @@ class InstancedSolve {
   private:
     static constexpr std::uint32_t kNoReceiver = 0xFFFFFFFFu;
 
-    // Every organ triangle's area times its normal, in the world. The nodes' frames are
-    // not kept: all of them, beside the organs' light, made the peak of a plantation's
-    // solve, and a quarter of a tree's.
-    static std::vector<glm::vec3> OrganAreaNormals(const Scene& scene, std::size_t triangles) {
-        std::vector<glm::vec3> areaNormals;
-        areaNormals.reserve(triangles);
-        ForEachWorldFrame(scene, [&](const Node& node, const glm::dmat4& worldFromLocal) {
+    // Σ A |n · ω| over every organ triangle of the scene, in the world, for the direction
+    // of each of the scene's suns and sky cones (BeamsOf, the top's sources): what scales
+    // the top's ε (LevelProblem::organsProjectedArea), summed in one walk of the nodes'
+    // frames. Each triangle's A n held through the top's solve (12 bytes a triangle) made
+    // the peak of a plantation's.
+    std::vector<std::pair<glm::dvec3, double>> OrgansProjectedAreas() const {
+        std::vector<std::pair<glm::dvec3, double>> areas;
+        for (const DirectionalSource& source : BeamsOf(scene_, options_.hrc.skyCones))
+            areas.emplace_back(source.toward, 0.0);
+        ForEachWorldFrame(scene_, [&](const Node& node, const glm::dmat4& worldFromLocal) {
             if (!node.organ) return;
-            for (const Triangle& t : PlaceMesh(*node.organ->mesh, worldFromLocal))
-                areaNormals.push_back(glm::vec3(t.areaM2 * t.normal));
+            for (const Triangle& t : PlaceMesh(*node.organ->mesh, worldFromLocal)) {
+                for (auto& [omega, area] : areas)
+                    area += t.areaM2 * std::abs(glm::dot(t.normal, omega));
+            }
         });
-        return areaNormals;
+        return areas;
     }
 
     // Direct light alone: an opened instance takes the suns, sky and lamps alone, not what
@@ -227,7 +234,8 @@ class InstancedSolve {
     const Scene& scene_;
     const FlatScene& receivers_;
     const RayScene* const shadows_;
-    SunMaps sunMaps_;  // over shadows_, when it is given
+    SunMaps sunMaps_;                                             // over shadows_, when it is given
+    std::vector<std::pair<glm::dvec3, double>> organsProjected_;  // while the top is solved
     // Each part's organs in shadows_, when it is given (ShadowTriangles).
     std::vector<std::shared_ptr<const RayScene::TriangleRanges>> shadowTriangles_;
     const InstanceTree& tree_;
@@ -352,17 +360,15 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     problem.sources = std::move(sources);
     problem.errorW = errorW_;
     problem.sourceCount = sourceCount_;
-    // A n of every organ triangle of the scene, held while the top is solved: Σ A |n · ω|
-    // scales ε at the top as it scales HRC's on the flattened scene.
+    // Σ A |n · ω| over every organ triangle of the scene (OrgansProjectedAreas) scales ε at
+    // the top as it scales HRC's on the flattened scene.
     if (p == InstanceTree::kTop) {
-        problem.organsProjectedArea =
-            [areaNormals = std::make_shared<std::vector<glm::vec3>>(
-                 OrganAreaNormals(scene_, organTriangles_))](const glm::dvec3& omega) {
-                double area = 0.0;
-                for (const glm::vec3& an : *areaNormals)
-                    area += std::abs(glm::dot(glm::dvec3(an), omega));
-                return area;
-            };
+        problem.organsProjectedArea = [this](const glm::dvec3& omega) {
+            for (const auto& [toward, area] : organsProjected_) {
+                if (toward == omega) return area;
+            }
+            return 0.0;  // not a source of the top: the level's own organs and instances
+        };
     }
     problem.splitSurfaces = true;  // the surfaces' light, held by the contents (Build)
     problem.holdLevel = options_.holdOutside;
