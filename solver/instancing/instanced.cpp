@@ -72,6 +72,7 @@ class InstancedSolve {
           options_(DirectOnlyAlone(options)),
           out_(out),
           directions_(DirectionSet::OfLevel(options.hrc.directionLevel)) {
+        organReceiver_.reserve(receivers.receivers.size());
         for (std::uint32_t r = 0; r < receivers.receivers.size(); ++r) {
             const Receiver& receiver = receivers.receivers[r];
             if (receiver.kind == ReceiverKind::kOrgan) {

@@ -262,6 +262,11 @@ RayScene::RayScene(const FlatScene& frame, std::vector<RayRun> runs, const Place
         }
     }
     rtcCommitScene(top_);
+    if (runs_.size() == 1 && !runs_[0].moved) {  // one mesh: hits numbered as its own
+        xyz_ = runs_[0].xyz, indices_ = runs_[0].indices;
+        runs_.clear();
+        runFirst_.clear();
+    }
 }
 
 std::array<glm::dvec3, 3> RayScene::RunCorners(std::uint32_t t) const {

@@ -192,7 +192,8 @@ class RayScene {
     RTCScene top_ = nullptr;      // the triangles, or 9 instances of them in a periodic scene
     const float* xyz_ = nullptr;  // the triangles' vertices, 3 floats each
     const std::uint32_t* indices_ = nullptr;  // and their 3 vertex indices each
-    // Built from runs: each run's first triangle (by its geometry's id in top_, which the
+    // Built from runs of which some are copies (one mesh of its own is xyz_ and indices_):
+    // each run's first triangle (by its geometry's id in top_, which the
     // filter and hits read), its vertices and indices (its original's for a copy) and
     // where a copy is moved to; the originals' scenes, which copies instance.
     struct Run {
