@@ -10,6 +10,7 @@
 #include "solver/raytrace/raytrace.h"
 #include "solver/scene/world_frames.h"
 #include "solver/util/sampling.h"
+#include "tests/random_rays.h"
 #include "tests/scene_builders.h"
 
 namespace leaflux {
@@ -109,17 +110,7 @@ TEST(RayScene, CopiesHeldAsInstancesTraceAsTheirTriangles) {
     const int rays = 10000;
     int hits = 0, blocked = 0, differing = 0;
     for (int i = 0; i < rays; ++i) {
-        const auto t = static_cast<std::uint32_t>(random.Uniform() * organTriangles);
-        const Triangle& tri = flat.triangles[t];
-        const double u = random.Uniform(), v = random.Uniform() * (1.0 - u);
-        RayStart start{tri.a + u * (tri.b - tri.a) + v * (tri.c - tri.a), t};
-        if (i % 2 == 1)  // off the organs, in the crown
-            start = {start.origin + 0.05 * glm::dvec3(random.Uniform() - 0.5,
-                                                      random.Uniform() - 0.5,
-                                                      random.Uniform() - 0.5)};
-        const double z = 2.0 * random.Uniform() - 1.0, phi = 2.0 * kPi * random.Uniform();
-        const double s = std::sqrt(1.0 - z * z);
-        const glm::dvec3 direction(s * std::cos(phi), s * std::sin(phi), z);
+        const auto [start, direction] = RandomRay(random, flat, organTriangles, i % 2 == 1);
         const bool occluded = whole.Occluded(start, direction);
         const bool byOrgans = whole.OccludedByFirst(start, direction, INFINITY, organTriangles);
         const RayHit first = whole.Trace(start, direction);

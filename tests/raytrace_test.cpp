@@ -4,6 +4,7 @@
 
 #include "solver/generate/generator.h"
 #include "solver/util/sampling.h"
+#include "tests/random_rays.h"
 #include "tests/scene_builders.h"
 
 namespace leaflux {
@@ -281,17 +282,7 @@ TEST(RayScene, TrianglesPlacedStraightInTraceAsTheFlatScenes) {
     int hits = 0, blocked = 0, byGround = 0;  // by the organs, and by the ground or wall alone
     for (int i = 0; i < 4000; ++i) {
         // From a point of an organ triangle, or from a point in the crown, any way.
-        const std::uint32_t t = static_cast<std::uint32_t>(random.Uniform() * organTriangles);
-        const Triangle& tri = flat.triangles[t];
-        const double u = random.Uniform(), v = random.Uniform() * (1.0 - u);
-        RayStart start{tri.a + u * (tri.b - tri.a) + v * (tri.c - tri.a), t};
-        if (i % 2 == 1)
-            start = {start.origin + 0.05 * glm::dvec3(random.Uniform() - 0.5,
-                                                      random.Uniform() - 0.5,
-                                                      random.Uniform() - 0.5)};
-        const double z = 2.0 * random.Uniform() - 1.0, phi = 2.0 * kPi * random.Uniform();
-        const double s = std::sqrt(1.0 - z * z);
-        const glm::dvec3 direction(s * std::cos(phi), s * std::sin(phi), z);
+        const auto [start, direction] = RandomRay(random, flat, organTriangles, i % 2 == 1);
         const bool occluded = placed->Occluded(start, direction);
         EXPECT_EQ(occluded, whole.Occluded(start, direction)) << "ray " << i;
         const bool byOrgans = placed->OccludedByFirst(start, direction, INFINITY, organTriangles);
