@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "server/policy_proto.h"
 #include "solver/generate/generator.h"
 #include "solver/instancing/instanced.h"
@@ -84,6 +86,33 @@ TEST(Copies, OnePlantOrNoneRepeatedHasNoCopies) {
     AddTree(scene, tree, {3.0, 0.0, 0.0}, 100000);
     scene.Validate();
     EXPECT_TRUE(FindCopies(scene, ReceiversOf(scene)).empty());
+}
+
+TEST(Copies, TheOriginalIsTheFirstInTheReceiversOrder) {
+    // Plant 1 comes first among the roots, but its leaf after plant 2's among the receivers:
+    // plant 2 is the original, so that the ray engine holds it before its copy.
+    Scene scene = OneBandScene({{"leaf", Leaf(0.1, 0.05)}});
+    const std::shared_ptr<const Mesh> blade = Rectangle(0.1, 0.05, 0.0);
+    for (const NodeId root : {1, 2}) {
+        Node plant;
+        plant.id = root;
+        plant.type = NodeType::kPlant;
+        plant.parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(root, 0.0, 0.0));
+        scene.nodes.push_back(plant);
+    }
+    scene.nodes.push_back(OrganNode(20, "leaf20", blade, "leaf", 2));
+    scene.nodes.push_back(OrganNode(10, "leaf10", blade, "leaf", 1));
+    scene.Validate();
+    const FlatScene flat = Flatten(scene);
+    const std::vector<PlantCopy> copies = FindCopies(scene, flat);
+    ASSERT_EQ(copies.size(), 1u);
+    EXPECT_EQ(copies[0].original, 0u);
+    EXPECT_EQ(copies[0].firstReceiver, 1u);
+    const std::unique_ptr<RayScene> rays = SceneRays(scene, ReceiversOf(scene), true);
+    for (std::uint32_t t = 0; t < flat.triangles.size(); ++t) {
+        const std::array<glm::dvec3, 3> corners = rays->Corners(t);
+        EXPECT_LT(glm::length(corners[0] - flat.triangles[t].a), 1e-6) << t;
+    }
 }
 
 TEST(RayScene, CopiesHeldAsInstancesTraceAsTheirTriangles) {

@@ -89,15 +89,26 @@ std::uint64_t HashOf(const std::vector<PlantOrgan>& organs) {
 std::vector<PlantCopy> FindCopies(const Scene& scene, const FlatScene& flat) {
     const Plants plants(scene, flat);
     if (plants.Roots().size() < 2) return {};
-    // The first plant of each kind (by its organs' hash) and the plants that may copy it;
-    // the organs are compared whole before a plant is taken as a copy.
-    std::unordered_map<std::uint64_t, std::uint32_t> originalOf;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> candidates;  // (plant, original)
+    // Each plant's organs' hash, in the order of their receivers: the first plant of each
+    // kind is its original, which the engine holds before its copies, and the others may
+    // copy it; their organs are compared whole before a plant is taken as a copy.
+    struct Plant {
+        std::uint32_t firstReceiver, root;
+        std::uint64_t hash;
+    };
+    std::vector<Plant> kinds;
     std::vector<PlantOrgan> organs, original;
     for (const std::uint32_t root : plants.Roots()) {
-        if (!plants.Organs(root, organs)) continue;
-        const auto [at, added] = originalOf.emplace(HashOf(organs), root);
-        if (!added) candidates.emplace_back(root, at->second);
+        if (plants.Organs(root, organs))
+            kinds.push_back({plants.FirstReceiver(organs), root, HashOf(organs)});
+    }
+    std::sort(kinds.begin(), kinds.end(),
+              [](const Plant& a, const Plant& b) { return a.firstReceiver < b.firstReceiver; });
+    std::unordered_map<std::uint64_t, std::uint32_t> originalOf;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> candidates;  // (plant, original)
+    for (const Plant& plant : kinds) {
+        const auto [at, added] = originalOf.emplace(plant.hash, plant.root);
+        if (!added) candidates.emplace_back(plant.root, at->second);
     }
     // By original, so that each original's organs are gathered once.
     std::sort(candidates.begin(), candidates.end(),

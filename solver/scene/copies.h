@@ -29,7 +29,7 @@ struct PlantCopy {
 
 // The copies among the plants (topology roots) of a validated scene, in the order of their
 // receivers; `flat` is the scene's flat scene or ReceiversOf it. An original is the first
-// plant of its kind in the roots' order and copies nothing; a plant whose organs are not
+// plant of its kind in the receivers' order and copies nothing; a plant whose organs are not
 // consecutive receivers is no copy and no original. Equal frames are equal to the bit:
 // copies are exact, never merely close.
 std::vector<PlantCopy> FindCopies(const Scene& scene, const FlatScene& flat);
