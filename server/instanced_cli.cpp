@@ -32,9 +32,9 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
         .add_option("--shadows", command.shadows,
                     "instanced: what direct light from the suns and sky meets: geometry (every "
                     "triangle of the scene, exact shadows, the scene's triangles in memory), "
-                    "geometry-compact (the same in a compact ray-engine hierarchy, and plants "
-                    "that are exact copies of another held once: about 30 % less memory for "
-                    "the triangles, nearly all of it for copies, up to 45 % slower) or "
+                    "geometry-compact (the same in a compact ray-engine hierarchy: about 30 % "
+                    "less memory for the triangles, and the plants that are exact copies of "
+                    "another held once, nearly none for theirs; up to 45 % slower) or "
                     "transmittance (the "
                     "closed instances' τ, the paper's; memory follows the depth of instances)")
         ->capture_default_str()
