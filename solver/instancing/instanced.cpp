@@ -116,9 +116,8 @@ class InstancedSolve {
   private:
     static constexpr std::uint32_t kNoReceiver = 0xFFFFFFFFu;
 
-    // Σ A |n · ω| over every organ triangle, for each of the top's sources (BeamsOf), which
-    // scales its ε (LevelProblem::organsProjectedArea), in one walk: each triangle's A n
-    // held through the top's solve (12 bytes a triangle) made a plantation's peak.
+    // Σ A |n · ω| over every organ triangle for each of the top's sources (BeamsOf), in one
+    // walk: each triangle's A n held through the top's solve made a plantation's peak.
     std::vector<std::pair<glm::dvec3, double>> OrgansProjectedAreas() const {
         std::vector<std::pair<glm::dvec3, double>> areas;
         for (const DirectionalSource& source : BeamsOf(scene_, options_.hrc.skyCones))
