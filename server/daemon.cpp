@@ -167,7 +167,7 @@ void Session::Count() {
     const Scene& scene = store_.Get();
     nodes_ = static_cast<int>(scene.nodes.size());
     organs_ = static_cast<int>(std::count_if(scene.nodes.begin(), scene.nodes.end(),
-                                             [](const Node& n) { return n.organ.has_value(); }));
+                                             [](const Node& n) { return n.organ().has_value(); }));
 }
 
 v1::CycleResult Session::Run(const v1::Cycle& cycle) {

@@ -117,12 +117,13 @@ void ReadImports(const v1::Scene& message, Scene& scene, const std::filesystem::
             node.id += import.id_offset();
             if (node.parent == kNoParent) {
                 node.parent = import.parent();
-                node.parentFromLocal = frame * glm::dmat4(node.parentFromLocal);
+                node.Edit().parentFromLocal = frame * glm::dmat4(node.parentFromLocal());
             } else {
                 node.parent += import.id_offset();
             }
-            if (node.organ)
-                node.organ->opticsId = OpticsFor(node.organ->opticsId, import, created, field);
+            if (node.organ())
+                node.Edit().organ->opticsId =
+                    OpticsFor(node.organ()->opticsId, import, created, field);
             scene.nodes.push_back(std::move(node));
         }
         for (Surface& surface : geometry.environment) {

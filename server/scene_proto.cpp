@@ -310,9 +310,9 @@ Node NodeFromProto(const v1::Node& in, const MeshLibrary& meshes) {
     node.parent = in.parent();
     node.type = TypeFromProto(in.type());
     node.name = in.name();
-    node.parentFromLocal = FrameFromProto(in.frame(), "frame", in.id());
-    node.age = in.age();
-    node.attributes.insert(in.attributes().begin(), in.attributes().end());
+    node.Edit().parentFromLocal = FrameFromProto(in.frame(), "frame", in.id());
+    node.Edit().age = in.age();
+    node.Edit().attributes.insert(in.attributes().begin(), in.attributes().end());
     if (in.has_organ()) {
         const v1::Organ& organ = in.organ();
         std::shared_ptr<const Mesh> mesh;
@@ -326,7 +326,7 @@ Node NodeFromProto(const v1::Node& in, const MeshLibrary& meshes) {
         } else {
             mesh = MeshFromProto(organ.mesh(), "organ.mesh", in.id());
         }
-        node.organ = Organ{mesh, organ.optics()};
+        node.Edit().organ = Organ{mesh, organ.optics()};
     }
     return node;
 }

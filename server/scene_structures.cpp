@@ -204,10 +204,11 @@ void ExpandPlacements(const v1::Scene& message, const MeshLibrary& meshes,
             }
             if (node.parent == kNoParent) {
                 node.parent = job.rootParent;
-                if (node.parentFromLocal == Frame()) {
-                    node.parentFromLocal = job.rootFrame;  // exact: no product with identity
+                if (node.parentFromLocal() == Frame()) {
+                    node.Edit().parentFromLocal = job.rootFrame;  // exact: no product with identity
                 } else {
-                    node.parentFromLocal = job.rootFrame * glm::dmat4(node.parentFromLocal);
+                    node.Edit().parentFromLocal =
+                        job.rootFrame * glm::dmat4(node.parentFromLocal());
                 }
             } else {
                 node.parent = placed(node.parent);
@@ -245,7 +246,7 @@ class MeshWriter {
   public:
     MeshWriter(const Scene& scene, v1::Scene& message) : message_(message) {
         for (const Node& node : scene.nodes) {
-            if (node.organ) ++uses_[node.organ->mesh.get()];
+            if (node.organ()) ++uses_[node.organ()->mesh.get()];
         }
     }
 
@@ -273,10 +274,10 @@ void WriteNode(const Node& node, NodeId id, NodeId parent, const std::string& na
     out->set_parent(parent);
     out->set_type(TypeToProto(node.type));
     out->set_name(name);
-    if (withFrame) FrameToProto(node.parentFromLocal, out->mutable_frame());
-    out->set_age(node.age);
-    out->mutable_attributes()->insert(node.attributes.begin(), node.attributes.end());
-    if (node.organ) meshes.Write(*node.organ, out->mutable_organ());
+    if (withFrame) FrameToProto(node.parentFromLocal(), out->mutable_frame());
+    out->set_age(node.age());
+    out->mutable_attributes()->insert(node.attributes().begin(), node.attributes().end());
+    if (node.organ()) meshes.Write(*node.organ(), out->mutable_organ());
 }
 
 // A node's name as a structure holds it: a name ending in the node's id ("leaf1042", as
@@ -385,18 +386,18 @@ class InstancedWriter {
         const Node& node = nodes_[i];
         ClassKey key;
         key.type = static_cast<int>(node.type);
-        key.age = Bits(node.age);
-        for (const auto& [name, value] : node.attributes)
+        key.age = Bits(node.age());
+        for (const auto& [name, value] : node.attributes())
             key.attributes.push_back({name, Bits(value)});
-        key.mesh = node.organ ? node.organ->mesh.get() : nullptr;
-        key.optics = node.organ ? node.organ->opticsId.str() : std::string();
+        key.mesh = node.organ() ? node.organ()->mesh.get() : nullptr;
+        key.optics = node.organ() ? node.organ()->opticsId.str() : std::string();
         bool shareable = true;
         key.name = NameTemplate(node, shareable);
         if (!shareable) key.name += "\n" + std::to_string(node.id);  // a class of its own
         for (std::size_t c : children_[i]) {
             ChildKey child{static_cast<std::int64_t>(nodes_[c].id - node.id), {}, class_[c]};
             for (int k = 0; k < 12; ++k)
-                child.frame[k] = Bits(nodes_[c].parentFromLocal.At(k / 3, k % 3));
+                child.frame[k] = Bits(nodes_[c].parentFromLocal().At(k / 3, k % 3));
             key.children.push_back(child);
         }
         const auto [it, added] = classes.emplace(std::move(key), static_cast<int>(info_.size()));
@@ -436,7 +437,7 @@ class InstancedWriter {
                     structure ? structure->add_placements() : message_.add_placements();
                 p->set_structure(info.structure);
                 p->set_parent(parent);
-                FrameToProto(node.parentFromLocal, p->mutable_frame());
+                FrameToProto(node.parentFromLocal(), p->mutable_frame());
                 p->set_id_offset(node.id - base - static_cast<NodeId>(1 - info.minDelta));
                 continue;
             }

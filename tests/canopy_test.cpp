@@ -158,8 +158,8 @@ TEST(FilterT, LayersAreLitOneHalfQuarterAndGroundEighth) {
     for (int l = 0; l < 3; ++l) layers.push_back(std::make_shared<Mesh>());
     glm::dvec3 lo(1e30), hi(-1e30);
     for (const Node& node : geometry.nodes) {
-        if (!node.organ) continue;
-        const Mesh& mesh = *node.organ->mesh;
+        if (!node.organ()) continue;
+        const Mesh& mesh = *node.organ()->mesh;
         for (const glm::uvec3& t : mesh.triangles) {
             const double z = mesh.positions[t.x].z;
             Mesh& layer = *layers[z < 7.5 ? 0 : z < 12.5 ? 1 : 2];

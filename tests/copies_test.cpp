@@ -63,11 +63,11 @@ TEST(Copies, ThePlantsThatRepeatAreFoundMovedAndNoOthers) {
         return scene.nodes[receivers.receivers[copy.firstReceiver + copy.receivers / 2].declared];
     };
     Node& shifted = leafOf(copies[0]);
-    glm::dmat4 frame = shifted.parentFromLocal;
+    glm::dmat4 frame = shifted.parentFromLocal();
     frame[3].x += 1e-6;
-    shifted.parentFromLocal = frame;
+    shifted.Edit().parentFromLocal = frame;
     Node& own = leafOf(copies[3]);
-    own.organ->mesh = std::make_shared<const Mesh>(*own.organ->mesh);
+    own.Edit().organ->mesh = std::make_shared<const Mesh>(*own.organ()->mesh);
     scene.Validate();
     const std::vector<PlantCopy> left = FindCopies(scene, ReceiversOf(scene));
     ASSERT_EQ(left.size(), 2u);
@@ -97,7 +97,7 @@ TEST(Copies, TheOriginalIsTheFirstInTheReceiversOrder) {
         Node plant;
         plant.id = root;
         plant.type = NodeType::kPlant;
-        plant.parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(root, 0.0, 0.0));
+        plant.Edit().parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(root, 0.0, 0.0));
         scene.nodes.push_back(plant);
     }
     scene.nodes.push_back(OrganNode(20, "leaf20", blade, "leaf", 2));

@@ -96,7 +96,8 @@ TEST(HrcStem, AStripIsLitOnBothSidesAndATubeOnlyOutside) {
     EXPECT_EQ(s.light[1][0].irradianceLowerWm2, 0.0);
 
     // Turned round, the strip faces west: the east sun now lights its lower side.
-    scene.nodes[0].organ->mesh = Quad({0, 0.05, 0}, {0, -0.05, 0}, {0, -0.05, 1}, {0, 0.05, 1});
+    scene.nodes[0].Edit().organ->mesh =
+        Quad({0, 0.05, 0}, {0, -0.05, 0}, {0, -0.05, 1}, {0, 0.05, 1});
     const PreparedScene turned(scene);
     const Solution t = SolveWithHrc(turned, 1e-4);
     EXPECT_NEAR(t.light[0][0].irradianceLowerWm2, 1000 * std::cos(glm::radians(30.0)), 1e-6);

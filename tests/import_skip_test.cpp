@@ -102,9 +102,9 @@ TEST(OpfSkip, ZeroLengthInternodeAndNaNDiametersAreSkippedAndNamed) {
     const std::string path = WriteTempFile("measured.opf", text);
     const ImportedGeometry g = ReadOpf(path);
     ASSERT_EQ(g.nodes.size(), 8u);  // every node stays in the topology
-    EXPECT_FALSE(NodeWithId(g, 5).organ);
-    EXPECT_FALSE(NodeWithId(g, 7).organ);
-    for (NodeId lit : {4u, 6u, 8u}) EXPECT_TRUE(NodeWithId(g, lit).organ) << lit;
+    EXPECT_FALSE(NodeWithId(g, 5).organ());
+    EXPECT_FALSE(NodeWithId(g, 7).organ());
+    for (NodeId lit : {4u, 6u, 8u}) EXPECT_TRUE(NodeWithId(g, lit).organ()) << lit;
     ASSERT_EQ(g.skipped.size(), 2u);
     EXPECT_EQ(g.skipped[0].node, 5u);
     EXPECT_NE(g.skipped[0].reason.find("singular"), std::string::npos) << g.skipped[0].reason;
@@ -132,7 +132,7 @@ TEST(OpfSkip, ZeroLengthInternodeAndNaNDiametersAreSkippedAndNamed) {
     const auto world = WorldFromLocal(scene);
     EXPECT_NEAR(glm::length(glm::dvec3(world.at(5)[3]) - glm::dvec3(0, 0, 0.10)), 0.0, 1e-12);
     EXPECT_NEAR(glm::length(glm::dvec3(world.at(6)[3]) - glm::dvec3(0.02, 0, 0.10)), 0.0, 1e-12);
-    EXPECT_NEAR(MeshArea(*NodeWithId(g, 6).organ->mesh, world.at(6)), 15e-4, 1e-12);
+    EXPECT_NEAR(MeshArea(*NodeWithId(g, 6).organ()->mesh, world.at(6)), 15e-4, 1e-12);
     EXPECT_NEAR(glm::length(glm::dvec3(world.at(8)[3]) - glm::dvec3(-0.08, 0, 0.20)), 0.0, 1e-12);
 }
 
@@ -212,13 +212,13 @@ TEST(OpfSkip, AFrameThatFlattensPartOfASharedMeshCopiesItForThatOrganOnly) {
     const ImportedGeometry g = ReadOpf(path);
     const Node& upright = NodeWithId(g, 2);
     const Node& flattened = NodeWithId(g, 3);
-    ASSERT_TRUE(upright.organ && flattened.organ);
-    EXPECT_EQ(upright.organ->mesh->triangles.size(), 2u);
-    EXPECT_EQ(upright.organ->mesh->name, "meshBDD mesh 0");  // still the shared mesh
-    ASSERT_EQ(flattened.organ->mesh->triangles.size(), 1u);  // its own copy
-    EXPECT_NE(flattened.organ->mesh, upright.organ->mesh);
-    EXPECT_EQ(flattened.organ->mesh->triangles[0], glm::uvec3(0, 1, 2));
-    EXPECT_FALSE(NodeWithId(g, 4).organ);
+    ASSERT_TRUE(upright.organ() && flattened.organ());
+    EXPECT_EQ(upright.organ()->mesh->triangles.size(), 2u);
+    EXPECT_EQ(upright.organ()->mesh->name, "meshBDD mesh 0");  // still the shared mesh
+    ASSERT_EQ(flattened.organ()->mesh->triangles.size(), 1u);  // its own copy
+    EXPECT_NE(flattened.organ()->mesh, upright.organ()->mesh);
+    EXPECT_EQ(flattened.organ()->mesh->triangles[0], glm::uvec3(0, 1, 2));
+    EXPECT_FALSE(NodeWithId(g, 4).organ());
     ASSERT_EQ(g.skipped.size(), 2u);
     EXPECT_EQ(g.skipped[0].node, 4u);  // read first: the NaN frame
     EXPECT_EQ(g.skipped[0].reason, "<mat> is not finite");
@@ -252,9 +252,9 @@ TEST(ObjSkip, ZeroAreaFacesAreSkippedByLineAndStrictRefusesThem) {
     const std::string path = WriteTempFile("flat.obj", text);
     const ImportedGeometry g = ReadObj(path);
     ASSERT_EQ(g.nodes.size(), 2u);
-    ASSERT_TRUE(g.nodes[0].organ);
-    EXPECT_EQ(g.nodes[0].organ->mesh->triangles.size(), 2u);  // line 8 and line 11's first
-    EXPECT_FALSE(g.nodes[1].organ);
+    ASSERT_TRUE(g.nodes[0].organ());
+    EXPECT_EQ(g.nodes[0].organ()->mesh->triangles.size(), 2u);  // line 8 and line 11's first
+    EXPECT_FALSE(g.nodes[1].organ());
     std::vector<std::string> where;
     for (const SkippedGeometry& s : g.skipped) where.push_back(s.where);
     ASSERT_EQ(where, (std::vector<std::string>{path + ":9", path + ":10", path + ":11",
@@ -279,7 +279,7 @@ TEST(CanSkip, ZeroAreaPolygonsAreSkippedByLineAndStrictRefusesThem) {
     const std::string path = WriteTempFile("flat.can", text);
     const ImportedGeometry g = ReadCan(path);
     int organs = 0;
-    for (const Node& node : g.nodes) organs += node.organ.has_value();
+    for (const Node& node : g.nodes) organs += node.organ().has_value();
     EXPECT_EQ(organs, 1);
     ASSERT_EQ(g.environment.size(), 1u);
     EXPECT_EQ(g.environment[0].mesh->triangles.size(), 2u);
@@ -376,7 +376,7 @@ TEST(ImportErrors, HugeCoordinatesAreOutOfRangeNotZeroArea) {
     mesh->triangles = {{0, 1, 2}};
     Node leaf;
     leaf.id = 1;
-    leaf.organ = Organ{mesh, "leaf"};
+    leaf.Edit().organ = Organ{mesh, "leaf"};
     scene.nodes = {leaf};
     const InputError valid = ErrorOf([&] { scene.Validate(); });
     EXPECT_EQ(valid.Code(), ErrorCode::kInvalidArgument);

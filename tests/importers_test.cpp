@@ -22,7 +22,7 @@ using testing::WriteTempFile;
 int TriangleCount(const ImportedGeometry& g) {
     int count = 0;
     for (const Node& node : g.nodes)
-        count += node.organ ? static_cast<int>(node.organ->mesh->triangles.size()) : 0;
+        count += node.organ() ? static_cast<int>(node.organ()->mesh->triangles.size()) : 0;
     return count;
 }
 
@@ -32,8 +32,8 @@ TEST(ReadObj, ReadsEachLeafPrototypeAsOneNamedOrgan) {
         ASSERT_EQ(g.nodes.size(), 1u) << file;
         EXPECT_EQ(g.nodes[0].name, "leaf");
         EXPECT_EQ(g.nodes[0].type, NodeType::kLeaf);
-        EXPECT_FALSE(g.nodes[0].organ->opticsId.empty());
-        EXPECT_GT(MeshArea(*g.nodes[0].organ->mesh, glm::dmat4(1.0)), 0.0);
+        EXPECT_FALSE(g.nodes[0].organ()->opticsId.empty());
+        EXPECT_GT(MeshArea(*g.nodes[0].organ()->mesh, glm::dmat4(1.0)), 0.0);
     }
     // Quads are split in two: the Almond leaf's 16 faces.
     EXPECT_GE(TriangleCount(ReadObj(Data("leaves/AlmondLeaf.obj"))), 16);
@@ -48,9 +48,9 @@ TEST(ReadObj, SplitsGroupsAndMaterials) {
     const ImportedGeometry g = ReadObj(path);
     ASSERT_EQ(g.nodes.size(), 3u);
     EXPECT_EQ(g.nodes[0].name, "stem");
-    EXPECT_EQ(g.nodes[0].organ->opticsId, "bark");
+    EXPECT_EQ(g.nodes[0].organ()->opticsId, "bark");
     EXPECT_EQ(g.nodes[0].type, NodeType::kInternode);
-    EXPECT_EQ(g.nodes[1].organ->opticsId, "green");
+    EXPECT_EQ(g.nodes[1].organ()->opticsId, "green");
     EXPECT_EQ(g.nodes[2].name, "blade/yellow");
 }
 
@@ -72,10 +72,10 @@ TEST(ReadCan, DecodesLabelsOfTheSeedlingTray) {
     int plants = 0, species1 = 0, species2 = 0;
     for (const Node& node : g.nodes) {
         plants += node.type == NodeType::kPlant;
-        if (!node.organ) continue;
+        if (!node.organ()) continue;
         EXPECT_NE(node.parent, kNoParent);
-        species1 += node.organ->opticsId.str().rfind("species1", 0) == 0;
-        species2 += node.organ->opticsId.str().rfind("species2", 0) == 0;
+        species1 += node.organ()->opticsId.str().rfind("species1", 0) == 0;
+        species2 += node.organ()->opticsId.str().rfind("species2", 0) == 0;
     }
     EXPECT_GT(plants, 1);
     EXPECT_GT(species1, 0);
@@ -125,10 +125,10 @@ TEST(ReadOpf, KeepsSharedMeshesAndTheTopology) {
     int organs = 0, leaves = 0;
     std::set<const Mesh*> meshes;
     for (const Node& node : g.nodes) {
-        if (!node.organ) continue;
+        if (!node.organ()) continue;
         ++organs;
         leaves += node.type == NodeType::kLeaf;
-        meshes.insert(node.organ->mesh.get());
+        meshes.insert(node.organ()->mesh.get());
     }
     EXPECT_EQ(organs, 4);
     EXPECT_EQ(leaves, 2);

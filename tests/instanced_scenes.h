@@ -27,10 +27,10 @@ inline Scene Copies(int copies, int leaves, double spacing = 1.2) {
         next = AddTree(scene, tree, {0.0, 0.0, 0.0}, next);
         Node& root = scene.nodes[first];
         EXPECT_EQ(root.parent, kNoParent);
-        root.parentFromLocal =
+        root.Edit().parentFromLocal =
             glm::rotate(glm::translate(glm::dmat4(1.0), {spacing * c, 0.25 * spacing * c, 0.0}),
                         0.9 * c, glm::dvec3(0, 0, 1)) *
-            glm::dmat4(root.parentFromLocal);
+            glm::dmat4(root.parentFromLocal());
     }
     Sun sun = SunAt(55.0, 140.0, 500.0);
     sun.normalIrradianceWm2 = {500.0, 450.0};

@@ -595,7 +595,7 @@ TEST(Instanced, TheSceneMovedAndTurnedGetsTheSameLight) {
                                           glm::half_pi<double>(), glm::dvec3(0, 0, 1));
     for (Node& node : scene.nodes) {
         if (node.parent == kNoParent)
-            node.parentFromLocal = motion * glm::dmat4(node.parentFromLocal);
+            node.Edit().parentFromLocal = motion * glm::dmat4(node.parentFromLocal());
     }
     for (Sun& sun : scene.sources.suns)
         sun.towardSun = glm::dvec3(motion * glm::dvec4(sun.towardSun, 0.0));

@@ -44,7 +44,7 @@ Scene LeafCloud(int n, double side, double edge, std::uint64_t seed, BandOptics 
                                        Quad(centre - h * u - h * v, centre + h * u - h * v,
                                             centre + h * u + h * v, centre - h * u + h * v),
                                        "leaf", 1);
-        leaf.parentFromLocal = contents;
+        leaf.Edit().parentFromLocal = contents;
         scene.nodes.push_back(std::move(leaf));
     }
     return scene;
@@ -254,7 +254,7 @@ TEST(PhaseFunction, FunctionsAreInvariantUnderRigidMotion) {
     // Where the structure stands does not matter: its functions are in its own frame.
     Scene placed = LeafCloud(40, 0.06, 0.3, 9, optics);
     const PhaseEstimate base = PhaseFromPhotons(StructureAlone(placed, 1), options);
-    placed.nodes[0].parentFromLocal =
+    placed.nodes[0].Edit().parentFromLocal =
         glm::rotate(glm::translate(glm::dmat4(1.0), {3e3, -2e3, 40.0}), 0.7, {0.3, 0.2, 0.9});
     const PhaseEstimate moved = PhaseFromPhotons(StructureAlone(placed, 1), options);
     for (std::size_t k = 0; k < base.phase.Values().size(); ++k)

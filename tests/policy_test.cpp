@@ -403,7 +403,7 @@ std::unordered_map<NodeId, std::int64_t> LeavesByWalkingUp(const Scene& scene) {
     for (const Node& node : scene.nodes) byId[node.id] = &node;
     std::unordered_map<NodeId, std::int64_t> leaves;
     for (const Node& node : scene.nodes) {
-        if (node.type != NodeType::kLeaf || !node.organ) continue;
+        if (node.type != NodeType::kLeaf || !node.organ()) continue;
         for (const Node* n = &node; n; n = n->parent ? byId.at(n->parent) : nullptr) {
             ++leaves[n->id];
         }
@@ -571,7 +571,7 @@ TEST(SignatureOnGeneratedTree, InclinationIsEachStructuresAngleFromTheWorldsUp) 
         Scene moved = scene;
         for (Node& node : moved.nodes) {
             if (node.parent == kNoParent)
-                node.parentFromLocal = motion * glm::dmat4(node.parentFromLocal);
+                node.Edit().parentFromLocal = motion * glm::dmat4(node.parentFromLocal());
         }
         return ComputeSignatures(moved, policy);
     };

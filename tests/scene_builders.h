@@ -66,7 +66,7 @@ inline Node OrganNode(NodeId id, const std::string& name, std::shared_ptr<const 
     node.parent = parent;
     node.type = NodeType::kLeaf;
     node.name = name;
-    node.organ = leaflux::Organ{std::move(mesh), optics};
+    node.Edit().organ = leaflux::Organ{std::move(mesh), optics};
     return node;
 }
 

@@ -66,11 +66,11 @@ TEST(SceneFile, RoundTripsAGeneratedTreeKeepingSharedMeshes) {
         EXPECT_EQ(back.nodes[i].type, scene.nodes[i].type);
         for (int c = 0; c < 4; ++c) {
             for (int r = 0; r < 3; ++r) {
-                EXPECT_DOUBLE_EQ(back.nodes[i].parentFromLocal.At(c, r),
-                                 scene.nodes[i].parentFromLocal.At(c, r));
+                EXPECT_DOUBLE_EQ(back.nodes[i].parentFromLocal().At(c, r),
+                                 scene.nodes[i].parentFromLocal().At(c, r));
             }
         }
-        if (back.nodes[i].organ) meshes.insert(back.nodes[i].organ->mesh.get());
+        if (back.nodes[i].organ()) meshes.insert(back.nodes[i].organ()->mesh.get());
     }
     EXPECT_EQ(meshes.size(), 2u);  // one leaf prototype, one internode prototype
     EXPECT_EQ(back.sources.skies[0].discretization, SkyDiscretization::kTurtle46);

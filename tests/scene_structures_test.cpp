@@ -72,14 +72,14 @@ void ExpectSameNodes(const Scene& a, const Scene& b) {
         EXPECT_EQ(x.parent, y.parent) << "node " << x.id;
         EXPECT_EQ(x.type, y.type) << "node " << x.id;
         EXPECT_EQ(x.name, y.name) << "node " << x.id;
-        EXPECT_TRUE(SameBits(x.parentFromLocal, y.parentFromLocal)) << "node " << x.id;
-        EXPECT_EQ(x.age, y.age) << "node " << x.id;
-        EXPECT_EQ(x.attributes, y.attributes) << "node " << x.id;
-        ASSERT_EQ(x.organ.has_value(), y.organ.has_value()) << "node " << x.id;
-        if (!x.organ) continue;
-        EXPECT_EQ(x.organ->opticsId, y.organ->opticsId);
-        EXPECT_EQ(x.organ->mesh->positions, y.organ->mesh->positions) << "node " << x.id;
-        EXPECT_EQ(x.organ->mesh->triangles, y.organ->mesh->triangles) << "node " << x.id;
+        EXPECT_TRUE(SameBits(x.parentFromLocal(), y.parentFromLocal())) << "node " << x.id;
+        EXPECT_EQ(x.age(), y.age()) << "node " << x.id;
+        EXPECT_EQ(x.attributes(), y.attributes()) << "node " << x.id;
+        ASSERT_EQ(x.organ().has_value(), y.organ().has_value()) << "node " << x.id;
+        if (!x.organ()) continue;
+        EXPECT_EQ(x.organ()->opticsId, y.organ()->opticsId);
+        EXPECT_EQ(x.organ()->mesh->positions, y.organ()->mesh->positions) << "node " << x.id;
+        EXPECT_EQ(x.organ()->mesh->triangles, y.organ()->mesh->triangles) << "node " << x.id;
     }
 }
 
@@ -111,20 +111,20 @@ Below Describe(const Scene& scene, NodeId top) {
     Below below;
     std::vector<std::pair<const Node*, glm::dmat4>> stack;
     for (auto it = children[top].rbegin(); it != children[top].rend(); ++it) {
-        stack.push_back({*it, glm::dmat4((*it)->parentFromLocal)});
+        stack.push_back({*it, glm::dmat4((*it)->parentFromLocal())});
     }
     while (!stack.empty()) {
         const auto [node, topFromLocal] = stack.back();
         stack.pop_back();
         below.types.push_back(node->type);
-        below.attributes.push_back(node->attributes);
-        if (node->organ) {
+        below.attributes.push_back(node->attributes());
+        if (node->organ()) {
             below.topFromOrgan.push_back(topFromLocal);
-            below.meshes.push_back(node->organ->mesh.get());
+            below.meshes.push_back(node->organ()->mesh.get());
         }
         const auto& c = children[node->id];
         for (auto it = c.rbegin(); it != c.rend(); ++it) {
-            stack.push_back({*it, topFromLocal * glm::dmat4((*it)->parentFromLocal)});
+            stack.push_back({*it, topFromLocal * glm::dmat4((*it)->parentFromLocal())});
         }
     }
     return below;
@@ -142,10 +142,10 @@ bool ExactCopies(const Below& a, const Below& b) {
 std::map<std::pair<int, std::size_t>, std::vector<NodeId>> AxesByClass(const Scene& scene) {
     std::map<std::pair<int, std::size_t>, std::vector<NodeId>> classes;
     for (const Node& node : scene.nodes) {
-        if (node.type != NodeType::kAxis || node.attributes.at("order") < 1) continue;
+        if (node.type != NodeType::kAxis || node.attributes().at("order") < 1) continue;
         std::size_t leaves = 0;
         for (NodeType type : Describe(scene, node.id).types) leaves += type == NodeType::kLeaf;
-        classes[{static_cast<int>(node.attributes.at("order")), leaves}].push_back(node.id);
+        classes[{static_cast<int>(node.attributes().at("order")), leaves}].push_back(node.id);
     }
     return classes;
 }
@@ -216,7 +216,7 @@ TEST(GeneratorCopies, KeepsTheLeafCountAndTheDefaultTree) {
         };
         mix(&node.id, sizeof node.id);
         mix(&node.parent, sizeof node.parent);
-        const glm::dmat4 frame(node.parentFromLocal);  // as the digest was first taken
+        const glm::dmat4 frame(node.parentFromLocal());  // as the digest was first taken
         mix(&frame, sizeof frame);
     }
     EXPECT_EQ(scene.nodes.size(), 1173u);
@@ -250,7 +250,7 @@ TEST(InstancedSceneFile, RoundTripsAPlantationOfCopiesNodeByNode) {
     auto meshes = [](const Scene& s) {
         std::set<const Mesh*> distinct;
         for (const Node& node : s.nodes) {
-            if (node.organ) distinct.insert(node.organ->mesh.get());
+            if (node.organ()) distinct.insert(node.organ()->mesh.get());
         }
         return distinct.size();
     };
@@ -273,7 +273,7 @@ TEST(InstancedSceneFile, RoundTripsTheDefaultPlantationAndAHandMadeScene) {
         p.id = plant;
         p.type = NodeType::kPlant;
         p.name = "tree";
-        p.parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(plant * 0.1, 0, 0));
+        p.Edit().parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(plant * 0.1, 0, 0));
         hand.nodes.push_back(p);
         for (NodeId k : {3, 1, 2}) {
             Node l;
@@ -281,8 +281,8 @@ TEST(InstancedSceneFile, RoundTripsTheDefaultPlantationAndAHandMadeScene) {
             l.parent = plant;
             l.type = NodeType::kLeaf;
             l.name = "leaf" + std::to_string(l.id);
-            l.parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0, 0.1 * k));
-            l.organ = Organ{leaf, "leaf"};
+            l.Edit().parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0, 0.1 * k));
+            l.Edit().organ = Organ{leaf, "leaf"};
             hand.nodes.push_back(l);
         }
     }
@@ -360,8 +360,28 @@ placements { structure: "plant" id_offset: 200 }
     EXPECT_LT(glm::length(glm::dvec3(world.at(106)[3]) - glm::dvec3(5, 0, 1)),
               1e-12);  // frames composed
     EXPECT_LT(glm::length(glm::dvec3(world.at(104)[0]) - glm::dvec3(0, 1, 0)),
-              1e-12);                                           // turned by its placement
-    EXPECT_EQ(byId[105]->organ->mesh, byId[205]->organ->mesh);  // meshes stay shared
+              1e-12);                                               // turned by its placement
+    EXPECT_EQ(byId[105]->organ()->mesh, byId[205]->organ()->mesh);  // meshes stay shared
+}
+
+TEST(InstancedSceneFile, PlacedCopiesShareTheirNodesBodiesUntilOneChanges) {
+    Scene scene = Load(std::string(kHeader) + R"(
+placements { structure: "plant" id_offset: 100 frame { m: [1, 0, 0, 5,  0, 1, 0, 0,  0, 0, 1, 0] } }
+placements { structure: "plant" id_offset: 200 }
+)");
+    std::map<NodeId, Node*> byId;
+    for (Node& node : scene.nodes) byId[node.id] = &node;
+    ASSERT_TRUE(byId.count(105) && byId.count(205) && byId.count(101) && byId.count(201));
+    EXPECT_TRUE(byId[105]->SharesBodyWith(*byId[205]));   // the leaf: held once
+    EXPECT_FALSE(byId[101]->SharesBodyWith(*byId[201]));  // a root moved by its placement
+    const glm::dmat4 before(byId[205]->parentFromLocal());
+    byId[105]->Edit().parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0, 9));
+    byId[105]->Edit().organ->opticsId = "bark";
+    EXPECT_FALSE(byId[105]->SharesBodyWith(*byId[205]));
+    EXPECT_EQ(glm::dmat4(byId[205]->parentFromLocal()), before);
+    EXPECT_EQ(byId[205]->organ()->opticsId.str(), "leaf");
+    EXPECT_EQ(byId[105]->organ()->mesh, byId[205]->organ()->mesh);
+    EXPECT_EQ(byId[105]->parentFromLocal().At(3, 2), 9.0);
 }
 
 struct BadFile {

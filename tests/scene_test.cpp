@@ -100,7 +100,7 @@ std::vector<BadInput> BadInputs() {
          ErrorCode::kAlreadyExists,
          "optics[leaf]",
          {}},
-        {"unknown optics", [](Scene& s) { s.nodes[1].organ->opticsId = "bark"; },
+        {"unknown optics", [](Scene& s) { s.nodes[1].Edit().organ->opticsId = "bark"; },
          ErrorCode::kNotFound, "organ.optics", 2},
         {"unknown parent", [](Scene& s) { s.nodes[1].parent = 99; }, ErrorCode::kNotFound, "parent",
          2},
@@ -115,45 +115,49 @@ std::vector<BadInput> BadInputs() {
         {"self parent", [](Scene& s) { s.nodes[0].parent = 1; }, ErrorCode::kCycle, "parent", 1},
         {"NaN frame",
          [](Scene& s) {
-             s.nodes[0].parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(kNan, 0, 0));
+             s.nodes[0].Edit().parentFromLocal =
+                 glm::translate(glm::dmat4(1.0), glm::dvec3(kNan, 0, 0));
          },
          ErrorCode::kInvalidArgument, "frame", 1},
         {"singular frame",
          [](Scene& s) {
-             s.nodes[0].parentFromLocal = glm::scale(glm::dmat4(1.0), {1, 1, 0});
+             s.nodes[0].Edit().parentFromLocal = glm::scale(glm::dmat4(1.0), {1, 1, 0});
          },
          ErrorCode::kDegenerate, "frame", 1},
-        {"infinite age", [](Scene& s) { s.nodes[0].age = kInf; }, ErrorCode::kInvalidArgument,
-         "age", 1},
-        {"NaN attribute", [](Scene& s) { s.nodes[0].attributes["vigour"] = kNan; },
+        {"infinite age", [](Scene& s) { s.nodes[0].Edit().age = kInf; },
+         ErrorCode::kInvalidArgument, "age", 1},
+        {"NaN attribute", [](Scene& s) { s.nodes[0].Edit().attributes["vigour"] = kNan; },
          ErrorCode::kInvalidArgument, "attributes[vigour]", 1},
         {"NaN vertex",
          [](Scene& s) {
-             s.nodes[1].organ->mesh = MeshWith({{0, 0, 0}, {1, 0, kNan}, {0, 1, 0}}, {{0, 1, 2}});
+             s.nodes[1].Edit().organ->mesh =
+                 MeshWith({{0, 0, 0}, {1, 0, kNan}, {0, 1, 0}}, {{0, 1, 2}});
          },
          ErrorCode::kInvalidArgument, "organ.mesh.positions[1]", 2},
         {"collapsed triangle",
          [](Scene& s) {
-             s.nodes[1].organ->mesh = MeshWith({{0, 0, 0}, {1, 0, 0}, {2, 0, 0}}, {{0, 1, 2}});
+             s.nodes[1].Edit().organ->mesh =
+                 MeshWith({{0, 0, 0}, {1, 0, 0}, {2, 0, 0}}, {{0, 1, 2}});
          },
          ErrorCode::kDegenerate, "organ.mesh.triangles[0]", 2},
         {"repeated vertex",
          [](Scene& s) {
-             s.nodes[1].organ->mesh = MeshWith({{0, 0, 0}, {1, 0, 0}}, {{0, 1, 1}});
+             s.nodes[1].Edit().organ->mesh = MeshWith({{0, 0, 0}, {1, 0, 0}}, {{0, 1, 1}});
          },
          ErrorCode::kDegenerate, "organ.mesh.triangles[0]", 2},
         {"index out of range",
          [](Scene& s) {
-             s.nodes[1].organ->mesh = MeshWith({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 3}});
+             s.nodes[1].Edit().organ->mesh =
+                 MeshWith({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 3}});
          },
          ErrorCode::kInvalidArgument, "organ.mesh.triangles[0]", 2},
-        {"empty mesh", [](Scene& s) { s.nodes[1].organ->mesh = MeshWith({}, {}); },
+        {"empty mesh", [](Scene& s) { s.nodes[1].Edit().organ->mesh = MeshWith({}, {}); },
          ErrorCode::kDegenerate, "organ.mesh.triangles", 2},
         {"frame collapses a leaf",
          [](Scene& s) {
              glm::dmat4 frame(1.0);
              frame[1] = glm::dvec4(1e-40, 0, 0, 0);
-             s.nodes[0].parentFromLocal = frame;
+             s.nodes[0].Edit().parentFromLocal = frame;
          },
          ErrorCode::kDegenerate, "frame", 1},
         {"duplicate organ name",
@@ -185,19 +189,19 @@ std::vector<BadInput> BadInputs() {
         // the scale: never lit with overflowing areas.
         {"leaf scaled by 1e15",
          [](Scene& s) {
-             s.nodes[1].parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e15));
+             s.nodes[1].Edit().parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e15));
          },
          ErrorCode::kInvalidArgument, "organ.mesh.triangles[0]", 2},
         {"leaf scaled by 1e20",
          [](Scene& s) {
-             s.nodes[1].parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e20));
+             s.nodes[1].Edit().parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e20));
          },
          ErrorCode::kInvalidArgument, "organ.mesh.triangles[0]", 2},
         // Past single precision's range (3.4e38), where a frame keeps its scale, the frame
         // itself is refused as not finite.
         {"leaf scaled by 1e300",
          [](Scene& s) {
-             s.nodes[1].parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e300));
+             s.nodes[1].Edit().parentFromLocal = glm::scale(glm::dmat4(1.0), glm::dvec3(1e300));
          },
          ErrorCode::kInvalidArgument, "frame", 2},
         {"sun of 1e308 W/m²",
@@ -322,11 +326,11 @@ TEST(Scene, NamesTheFirstFailingOrganInTheNodesOrder) {
     scene.nodes.insert(scene.nodes.begin(), OrganNode(3, "leaf3", flat, "leaf", 1));
     EXPECT_EQ(errorOf(scene), std::pair(ErrorCode::kDegenerate, std::optional<NodeId>(3)));
     // Leaf 3 whole again and leaf 5 named as leaf 4: leaf 4's mesh comes before the name.
-    scene.nodes[0].organ->mesh = Rectangle(0.1, 0.05, 1.0);
+    scene.nodes[0].Edit().organ->mesh = Rectangle(0.1, 0.05, 1.0);
     scene.nodes.push_back(OrganNode(5, "leaf4", Rectangle(0.1, 0.05, 2.0), "leaf"));
     EXPECT_EQ(errorOf(scene), std::pair(ErrorCode::kDegenerate, std::optional<NodeId>(4)));
     // Leaf 4 whole: the name.
-    scene.nodes[1].organ->mesh = Rectangle(0.1, 0.05, 3.0);
+    scene.nodes[1].Edit().organ->mesh = Rectangle(0.1, 0.05, 3.0);
     EXPECT_EQ(errorOf(scene), std::pair(ErrorCode::kAlreadyExists, std::optional<NodeId>(5)));
     scene.nodes[3].name = "leaf5";
     EXPECT_NO_THROW(scene.Validate());
@@ -334,11 +338,11 @@ TEST(Scene, NamesTheFirstFailingOrganInTheNodesOrder) {
 
 TEST(Scene, WorldFromLocalComposesParentsFirst) {
     Scene scene = ValidScene();
-    scene.nodes[0].parentFromLocal =
+    scene.nodes[0].Edit().parentFromLocal =
         glm::translate(glm::dmat4(1.0), glm::dvec3(10, 0, 0));  // plant at x = 10
     glm::dmat4 leaf(2.0);                                       // leaf scaled ×2
     leaf[3] = glm::dvec4(0, 1, 0, 1);
-    scene.nodes[1].parentFromLocal = leaf;
+    scene.nodes[1].Edit().parentFromLocal = leaf;
     const auto world = WorldFromLocal(scene);
     const glm::dvec3 p = glm::dvec3(world.at(2) * glm::dvec4(1, 0, 0, 1));
     EXPECT_EQ(p, glm::dvec3(12, 1, 0));
@@ -346,9 +350,10 @@ TEST(Scene, WorldFromLocalComposesParentsFirst) {
 
 TEST(Flatten, KeepsMillimetresFarFromTheOrigin) {
     Scene scene = ValidScene();
-    scene.nodes[0].parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(1e5, 1e5, 0));
+    scene.nodes[0].Edit().parentFromLocal =
+        glm::translate(glm::dmat4(1.0), glm::dvec3(1e5, 1e5, 0));
     scene.environment.clear();
-    scene.nodes[1].organ->mesh = Rectangle(0.001, 0.001, 1.0);
+    scene.nodes[1].Edit().organ->mesh = Rectangle(0.001, 0.001, 1.0);
     const FlatScene flat = Flatten(scene);
     ASSERT_EQ(flat.receivers.size(), 1u);
     // World coordinates near 1e5 m carry double rounding of ~1e-11 m: the area is exact
@@ -406,7 +411,7 @@ TEST(SceneStore, FlattensAsTheWholeSceneAfterEachChange) {
     SceneStore store(start);
     ExpectSameFlat(store.Flat(), Flatten(store.Get()));
     const auto isAxis = [](const Node& n) {
-        return n.type == NodeType::kAxis && n.attributes.at("order") == 1.0;  // a branch
+        return n.type == NodeType::kAxis && n.attributes().at("order") == 1.0;  // a branch
     };
     const auto isPhytomer = [](const Node& n) { return n.type == NodeType::kPhytomer; };
     const auto isLeaf = [](const Node& n) { return n.type == NodeType::kLeaf; };
@@ -419,11 +424,11 @@ TEST(SceneStore, FlattensAsTheWholeSceneAfterEachChange) {
 
     SceneChange bend;
     Node phytomer = FindNode(store.Get(), isPhytomer);
-    phytomer.parentFromLocal =
-        glm::rotate(glm::dmat4(phytomer.parentFromLocal), 0.3, glm::dvec3(1, 0, 0));
+    phytomer.Edit().parentFromLocal =
+        glm::rotate(glm::dmat4(phytomer.parentFromLocal()), 0.3, glm::dvec3(1, 0, 0));
     bend.updated.push_back(phytomer);
     Node leaf = FindNode(store.Get(), isLeaf);
-    leaf.organ->mesh = Rectangle(0.2, 0.1, 0.0);
+    leaf.Edit().organ->mesh = Rectangle(0.2, 0.1, 0.0);
     bend.updated.push_back(leaf);
     store.Apply(bend);
     ExpectSameFlat(store.Flat(), Flatten(store.Get()));
@@ -449,8 +454,9 @@ TEST(SceneStore, ChecksTheOrgansAChangeMoves) {
     const Node& leaf =
         FindNode(store.Get(), [](const Node& n) { return n.type == NodeType::kLeaf; });
     Node phytomer = FindNode(store.Get(), [&](const Node& n) { return n.id == leaf.parent; });
-    ASSERT_FALSE(phytomer.organ.has_value());
-    phytomer.parentFromLocal = glm::scale(glm::dmat4(phytomer.parentFromLocal), glm::dvec3(1e-9));
+    ASSERT_FALSE(phytomer.organ().has_value());
+    phytomer.Edit().parentFromLocal =
+        glm::scale(glm::dmat4(phytomer.parentFromLocal()), glm::dvec3(1e-9));
     SceneChange shrink;
     shrink.updated.push_back(phytomer);
     try {
@@ -525,7 +531,7 @@ TEST(SceneStore, KeepsTheNamesOfOrgansUpdatedWhereNodesAreRemoved) {
     SceneChange change;
     change.removed.push_back(1);
     Node moved = start.nodes[2];  // leaf3, raised
-    moved.organ->mesh = Rectangle(0.1, 0.1, 2.0);
+    moved.Edit().organ->mesh = Rectangle(0.1, 0.1, 2.0);
     change.updated.push_back(moved);
     store.Apply(change);
     SceneChange taken;
@@ -555,7 +561,8 @@ TEST(SceneStore, UndoRestoresTheSceneBefore) {
     SceneChange change;
     change.removed.push_back(nth(NodeType::kAxis, 3).id);
     Node bent = nth(NodeType::kPhytomer, 1);
-    bent.parentFromLocal = glm::rotate(glm::dmat4(bent.parentFromLocal), 0.2, glm::dvec3(0, 1, 0));
+    bent.Edit().parentFromLocal =
+        glm::rotate(glm::dmat4(bent.parentFromLocal()), 0.2, glm::dvec3(0, 1, 0));
     change.updated.push_back(bent);
     Node renamed = nth(NodeType::kLeaf, 0);
     renamed.name = "renamed";
@@ -569,7 +576,7 @@ TEST(SceneStore, UndoRestoresTheSceneBefore) {
     for (std::size_t i = 0; i < start.nodes.size(); ++i) {
         EXPECT_EQ(store.Get().nodes[i].id, start.nodes[i].id);
         EXPECT_EQ(store.Get().nodes[i].name, start.nodes[i].name);
-        EXPECT_EQ(store.Get().nodes[i].parentFromLocal, start.nodes[i].parentFromLocal);
+        EXPECT_EQ(store.Get().nodes[i].parentFromLocal(), start.nodes[i].parentFromLocal());
     }
     EXPECT_EQ(store.Get().sources.suns.at(0).towardSun, start.sources.suns.at(0).towardSun);
     ExpectSameFlat(store.Flat(), Flatten(start));

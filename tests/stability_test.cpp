@@ -293,7 +293,7 @@ TEST_P(Stability, LampOneMillimetreBelowALeaf) {
 
 TEST_P(Stability, SunHalfADegreeAboveTheHorizon) {
     Scene scene = TwoLitLeaves(0.02, glm::dvec3(0.0));
-    scene.nodes[0].organ->mesh =
+    scene.nodes[0].Edit().organ->mesh =
         Quad({0, -0.05, 0.95}, {0, 0.05, 0.95}, {0, 0.05, 1.05}, {0, -0.05, 1.05});
     scene.sources.suns = {SunAt(0.5, 90, kSunWm2)};
     const Solution solution = Run(scene);

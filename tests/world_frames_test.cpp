@@ -19,7 +19,7 @@ Node At(NodeId id, NodeId parent, const glm::dmat4& parentFromLocal) {
     Node node;
     node.id = id;
     node.parent = parent;
-    node.parentFromLocal = parentFromLocal;
+    node.Edit().parentFromLocal = parentFromLocal;
     return node;
 }
 
@@ -29,7 +29,7 @@ glm::dmat4 ByWalkingUp(const Scene& scene, NodeId id) {
     while (id != kNoParent) {
         const Node& node = *std::find_if(scene.nodes.begin(), scene.nodes.end(),
                                          [&](const Node& n) { return n.id == id; });
-        frame = glm::dmat4(node.parentFromLocal) * frame;
+        frame = glm::dmat4(node.parentFromLocal()) * frame;
         id = node.parent;
     }
     return frame;

@@ -64,7 +64,7 @@ NodeId AppendCopy(Scene& scene, std::size_t begin, std::size_t end, NodeId first
         node.id = node.id - from + firstId;
         if (i == begin) {
             node.parent = parent;
-            node.parentFromLocal = parentFromLocal;
+            node.Edit().parentFromLocal = parentFromLocal;
         } else {
             node.parent = node.parent - from + firstId;
         }
@@ -123,7 +123,7 @@ class TreeBuilder {
         plant.type = NodeType::kPlant;
         plant.name = "plant" + std::to_string(plant.id);
         const glm::dmat4 world = FrameOf(base, {1, 0, 0}, {0, 1, 0}, {0, 0, 1});
-        plant.parentFromLocal = world;
+        plant.Edit().parentFromLocal = world;
         const NodeId plantId = plant.id;
         scene_.nodes.push_back(std::move(plant));
         Random random(StreamSeed(p_.seed, 0));
@@ -143,7 +143,7 @@ class TreeBuilder {
                const glm::dmat4& world) {
         node.id = next_++;
         node.parent = parent;
-        node.parentFromLocal = glm::inverse(worldFromParent) * world;
+        node.Edit().parentFromLocal = glm::inverse(worldFromParent) * world;
         if (node.name.empty()) node.name = NodeTypeName(node.type) + std::to_string(node.id);
         scene_.nodes.push_back(std::move(node));
         return scene_.nodes.back().id;
@@ -174,8 +174,8 @@ class TreeBuilder {
         const glm::dmat4 world = AxisFrame(worldFromParent, direction);
         Node axis;
         axis.type = NodeType::kAxis;
-        axis.age = depth;
-        axis.attributes["order"] = depth;
+        axis.Edit().age = depth;
+        axis.Edit().attributes["order"] = depth;
         const NodeId axisId = Add(std::move(axis), parent, worldFromParent, world);
 
         const bool shoot = depth >= depth_;
@@ -194,14 +194,14 @@ class TreeBuilder {
                 FrameOf(at, side, glm::cross(direction, side), direction);
             Node phytomer;
             phytomer.type = NodeType::kPhytomer;
-            phytomer.age = depth;
+            phytomer.Edit().age = depth;
             const NodeId phytomerId = Add(std::move(phytomer), axisId, world, phytomerWorld);
             // Twigs of the leafy shoots carry no geometry: thin against the leaves around
             // them, they would multiply the triangles for little light.
             if (p_.internodes && !shoot) {
                 Node internode;
                 internode.type = NodeType::kInternode;
-                internode.organ = Organ{internode_, p_.stemOptics};
+                internode.Edit().organ = Organ{internode_, p_.stemOptics};
                 const glm::dvec3 from = base + direction * previous;
                 Add(std::move(internode), phytomerId, phytomerWorld,
                     FrameOf(from, side * width, glm::cross(direction, side) * width,
@@ -246,8 +246,8 @@ class TreeBuilder {
         const double length = p_.leafLengthM * (0.8 + 0.4 * random.Uniform());
         Node leaf;
         leaf.type = NodeType::kLeaf;
-        leaf.organ = Organ{leaf_, p_.leafOptics};
-        leaf.attributes["length_m"] = length;
+        leaf.Edit().organ = Organ{leaf_, p_.leafOptics};
+        leaf.Edit().attributes["length_m"] = length;
         Add(std::move(leaf), phytomer, phytomerWorld,
             FrameOf(at, blade * length, width * (0.6 * length), normal));
     }
@@ -429,8 +429,9 @@ void AddRandomCanopy(Scene& scene, const CanopyParameters& p) {
         leaf.id = next++;
         leaf.type = NodeType::kLeaf;
         leaf.name = "leaf" + std::to_string(i + 1);
-        leaf.organ = Organ{quad, p.leafOptics};
-        leaf.parentFromLocal = FrameOf(centre, u * side, glm::cross(normal, u) * side, normal);
+        leaf.Edit().organ = Organ{quad, p.leafOptics};
+        leaf.Edit().parentFromLocal =
+            FrameOf(centre, u * side, glm::cross(normal, u) * side, normal);
         scene.nodes.push_back(std::move(leaf));
     }
 }

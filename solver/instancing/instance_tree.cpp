@@ -51,8 +51,8 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
         Part& part = parts_[owner[i]];
         part.nodes.push_back(i);
         const Node& node = scene.nodes[i];
-        if (node.organ)
-            part.triangles += static_cast<std::int64_t>(node.organ->mesh->triangles.size());
+        if (node.organ())
+            part.triangles += static_cast<std::int64_t>(node.organ()->mesh->triangles.size());
         if (owner[i] != kTop && parts_[owner[i]].root == node.id)
             parts_[part.parent].instances.push_back(owner[i]);
     }
@@ -62,15 +62,15 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
     // A part root's frame in the world, up its parents (the frames of every node would be
     // 136 bytes each).
     const auto worldFromRoot = [&](std::size_t i) {
-        glm::dmat4 frame(scene.nodes[i].parentFromLocal);
+        glm::dmat4 frame(scene.nodes[i].parentFromLocal());
         for (std::uint32_t up = topology.Parent(i); up != Topology::kNone; up = topology.Parent(up))
-            frame = glm::dmat4(scene.nodes[up].parentFromLocal) * frame;
+            frame = glm::dmat4(scene.nodes[up].parentFromLocal()) * frame;
         return frame;
     };
     const auto walkOrgans = [&](const Part& part, const auto& visit) {
         ForEachFrameUnder(scene, topology, part.rootIndex, glm::dmat4(1.0),
                           [&](const Node& node, const glm::dmat4& instanceFromNode) {
-                              if (node.organ) visit(*node.organ->mesh, instanceFromNode);
+                              if (node.organ()) visit(*node.organ()->mesh, instanceFromNode);
                           });
     };
     // Each part walks its own subtree, the parts at once: every level of them walks the

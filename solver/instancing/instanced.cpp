@@ -123,8 +123,8 @@ class InstancedSolve {
         for (const DirectionalSource& source : BeamsOf(scene_, options_.hrc.skyCones))
             areas.emplace_back(source.toward, 0.0);
         ForEachWorldFrame(scene_, [&](const Node& node, const glm::dmat4& worldFromLocal) {
-            if (!node.organ) return;
-            for (const Triangle& t : PlaceMesh(*node.organ->mesh, worldFromLocal)) {
+            if (!node.organ()) return;
+            for (const Triangle& t : PlaceMesh(*node.organ()->mesh, worldFromLocal)) {
                 for (auto& [omega, area] : areas)
                     area += t.areaM2 * std::abs(glm::dot(t.normal, omega));
             }
@@ -275,9 +275,9 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
     for (std::uint32_t q : part.instances) {
         const InstanceTree::Part& instance = tree_[q];
         const Node& root = scene_.nodes[instance.rootIndex];
-        const glm::dmat4 world = root.parent == kNoParent ? glm::dmat4(root.parentFromLocal)
+        const glm::dmat4 world = root.parent == kNoParent ? glm::dmat4(root.parentFromLocal())
                                                           : worldFromLocal.at(root.parent) *
-                                                                glm::dmat4(root.parentFromLocal);
+                                                                glm::dmat4(root.parentFromLocal());
         level->worldFromClosed.push_back(world);
         middle += glm::dvec3(world * glm::dvec4(Centre(instance.boxMin, instance.boxMax), 1.0));
     }

@@ -15,7 +15,7 @@
 namespace leaflux {
 namespace {
 
-bool IsLeafOrgan(const Node& node) { return node.type == NodeType::kLeaf && node.organ; }
+bool IsLeafOrgan(const Node& node) { return node.type == NodeType::kLeaf && node.organ(); }
 
 // Per node, by position in scene.nodes: the leaf organs in its subtree (sums from the last
 // node of a breadth-first order back to the roots), and, when asked, the angle (degrees)
@@ -78,13 +78,13 @@ StructureSignature Classify(const Node& node, std::int64_t leafCount, double inc
     s.id = node.id;
     s.type = node.type;
     s.leafCount = leafCount;
-    s.age = node.age;
+    s.age = node.age();
     s.inclination = inclination;
     s.attributeBins.assign(policy.attributes.size(), -1);
     for (const AttributeBins& attribute : policy.attributes) {
-        const auto found = node.attributes.find(attribute.name);
+        const auto found = node.attributes().find(attribute.name);
         s.attributes.push_back(
-            found == node.attributes.end() ? std::nullopt : std::optional<double>(found->second));
+            found == node.attributes().end() ? std::nullopt : std::optional<double>(found->second));
     }
     const std::string typeName = NodeTypeName(node.type);
     if (const FixedFunction* cap = policy.FixedFor(node.type);
@@ -101,7 +101,7 @@ StructureSignature Classify(const Node& node, std::int64_t leafCount, double inc
                          static_cast<double>(leafCount), s.leafBin);
     }
     if (binned && policy.age.Used()) {
-        binned = AddPart(signature, s.unbinned, policy.age, "age", "age", node.age, s.ageBin);
+        binned = AddPart(signature, s.unbinned, policy.age, "age", "age", node.age(), s.ageBin);
     }
     if (binned && policy.inclination.Used()) {
         binned = AddPart(signature, s.unbinned, policy.inclination, "incl", "inclination",
@@ -165,7 +165,7 @@ SceneSignatures ComputeSignatures(const Scene& scene, const InstancingPolicy& po
         const Node& node = scene.nodes[i];
         if (!policy.IsInstanceType(node.type)) continue;
         for (std::size_t a = 0; a < policy.attributes.size(); ++a) {
-            if (node.attributes.count(policy.attributes[a].name)) carried[a] = true;
+            if (node.attributes().count(policy.attributes[a].name)) carried[a] = true;
         }
         if (facts.leaves[i] == 0) continue;  // nothing to light: never an instance
         result.structures.push_back(Classify(node, facts.leaves[i],

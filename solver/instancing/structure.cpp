@@ -47,7 +47,8 @@ StructureAlone::StructureAlone(const Scene& scene, NodeId root) {
     if (flat_.Empty())
         throw InputError(ErrorCode::kDegenerate, "root", "has no organ under it", root);
     for (const Receiver& receiver : flat_.receivers) leafAreaM2_ += receiver.areaM2;
-    for (const Node& node : alone_.nodes) leafCount_ += node.organ && node.type == NodeType::kLeaf;
+    for (const Node& node : alone_.nodes)
+        leafCount_ += node.organ() && node.type == NodeType::kLeaf;
     const double pad =
         std::max(kMinPadM, kPadFraction * glm::length(flat_.boundsMax - flat_.boundsMin));
     boxMin_ = flat_.boundsMin - pad;

@@ -230,16 +230,16 @@ class OpfReader {
                 double value;
                 const auto [next, error] = std::from_chars(text, end, value);
                 if (error == std::errc() && std::all_of(next, end, IsSpace) && std::isfinite(value))
-                    node.attributes[std::string(name)] = value;
+                    node.Edit().attributes[std::string(name)] = value;
             }
         }
-        if (!unusable.empty() && (node.organ || !InvertibleFrame(worldFromLocal))) {
-            const bool hadOrgan = node.organ.has_value();
-            const std::size_t triangles = hadOrgan ? node.organ->mesh->triangles.size() : 0;
+        if (!unusable.empty() && (node.organ() || !InvertibleFrame(worldFromLocal))) {
+            const bool hadOrgan = node.organ().has_value();
+            const std::size_t triangles = hadOrgan ? node.organ()->mesh->triangles.size() : 0;
             unlit_.Skip({At(geometryAt), node.id, node.name,
                          unusable + (hadOrgan ? "" : " (no mesh; its children keep their frames)"),
                          triangles});
-            node.organ.reset();
+            node.Edit().organ.reset();
             if (!InvertibleFrame(worldFromLocal)) {
                 // The parent's axes at the node's own origin, when that origin is known.
                 const glm::dvec4 origin = worldFromLocal[3];
@@ -248,7 +248,7 @@ class OpfReader {
                     worldFromLocal[3] = glm::dvec4(glm::dvec3(origin), 1.0);
             }
         }
-        node.parentFromLocal = glm::inverse(worldFromParent) * worldFromLocal;
+        node.Edit().parentFromLocal = glm::inverse(worldFromParent) * worldFromLocal;
         const NodeId self = node.id;
         result_.nodes.push_back(std::move(node));
         for (const pugi::xml_node child : element.children()) {
@@ -307,8 +307,8 @@ class OpfReader {
                     ErrorCode::kNotFound, At(shape),
                     "shapeIndex " + std::to_string(index) + " names no shape of shapeBDD", node.id);
             }
-            node.organ = Organ{meshes_.at(found->second.first),
-                               "material" + std::to_string(found->second.second)};
+            node.Edit().organ = Organ{meshes_.at(found->second.first),
+                                      "material" + std::to_string(found->second.second)};
         }
     }
 

@@ -129,7 +129,7 @@ class ObjOrgans {
             node.name = Unique(name);
             node.type = TypeFromName(name);
             mesh_ = std::make_shared<Mesh>();
-            node.organ = Organ{mesh_, material_};
+            node.Edit().organ = Organ{mesh_, material_};
             organs_.push_back(std::move(node));
             current_ = static_cast<int>(organs_.size()) - 1;
         }
@@ -281,7 +281,7 @@ ImportedGeometry ReadCan(const std::string& path, const ImportOptions& options) 
                 const std::string material =
                     "species" + std::to_string(species) + (organ == 0 ? "_stem" : "");
                 found->second = {std::make_shared<Mesh>(), node.id, node.name};
-                node.organ = Organ{found->second.mesh, material};
+                node.Edit().organ = Organ{found->second.mesh, material};
                 result.nodes.push_back(std::move(node));
             }
             at = last = &found->second;

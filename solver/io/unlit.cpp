@@ -94,9 +94,9 @@ void UnlitGeometry::Finish(ImportedGeometry& geometry) {
 
     bool hadGeometry = false, hasGeometry = false;
     for (Node& node : geometry.nodes) {
-        if (!node.organ) continue;
+        if (!node.organ()) continue;
         hadGeometry = true;
-        const Mesh& mesh = *node.organ->mesh;
+        const Mesh& mesh = *node.organ()->mesh;
         const std::string& name = node.name;  // every importer names its nodes
         std::size_t count = 0;
         const std::vector<bool> unlit =
@@ -107,7 +107,7 @@ void UnlitGeometry::Finish(ImportedGeometry& geometry) {
                                          : "every triangle has zero area where its frame "
                                            "places it",
                   mesh.triangles.size()});
-            node.organ.reset();
+            node.Edit().organ.reset();
             continue;
         }
         if (count > 0) {
@@ -115,7 +115,7 @@ void UnlitGeometry::Finish(ImportedGeometry& geometry) {
                   std::to_string(count) + " of its " + std::to_string(mesh.triangles.size()) +
                       " triangles have zero area where its frame places them",
                   count});
-            node.organ->mesh = Without(mesh, unlit);
+            node.Edit().organ->mesh = Without(mesh, unlit);
         }
         hasGeometry = true;
     }

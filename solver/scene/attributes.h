@@ -8,14 +8,13 @@
 #pragma once
 
 #include <algorithm>
-#include <atomic>
-#include <cstdint>
-#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
+
+#include "solver/util/copy_on_write.h"
 
 namespace leaflux {
 
@@ -25,19 +24,6 @@ class Attributes {
     using const_iterator = std::vector<value_type>::const_iterator;
 
     Attributes() = default;
-    Attributes(const Attributes& other) : block_(other.block_) {
-        if (block_) block_->holders.fetch_add(1, std::memory_order_relaxed);
-    }
-    Attributes(Attributes&& other) noexcept : block_(std::exchange(other.block_, nullptr)) {}
-    Attributes& operator=(const Attributes& other) {
-        if (this != &other) *this = Attributes(other);
-        return *this;
-    }
-    Attributes& operator=(Attributes&& other) noexcept {
-        std::swap(block_, other.block_);
-        return *this;
-    }
-    ~Attributes() { Release(); }
 
     // The value named so, made 0 if absent (as std::map's). The reference is good until the
     // attributes are next copied (the copy shares what it refers to).
@@ -76,30 +62,9 @@ class Attributes {
 
   private:
     using Entries = std::vector<value_type>;
-    struct Block {
-        std::atomic<std::uint32_t> holders{1};
-        Entries entries;
-    };
-    const Entries& Held() const {
-        static const Entries none;
-        return block_ ? block_->entries : none;
-    }
-    // The entries to change: a block of this node's own, copied from the shared one.
-    Entries& Made() {
-        if (!block_) {
-            block_ = new Block;
-        } else if (block_->holders.load(std::memory_order_acquire) > 1) {
-            Block* own = new Block;
-            own->entries = block_->entries;
-            Release();
-            block_ = own;
-        }
-        return block_->entries;
-    }
-    void Release() {
-        if (block_ && block_->holders.fetch_sub(1, std::memory_order_acq_rel) == 1) delete block_;
-        block_ = nullptr;
-    }
+    const Entries& Held() const { return *entries_; }
+    // The entries to change: this node's own, copied from the shared ones.
+    Entries& Made() { return entries_.Edit(); }
     // Where `name` is, or would go.
     template <class Iterator>
     static Iterator LowerBound(Iterator first, Iterator last, std::string_view name) {
@@ -107,7 +72,7 @@ class Attributes {
             first, last, name, [](const value_type& e, std::string_view n) { return e.first < n; });
     }
 
-    Block* block_ = nullptr;  // null: none
+    CopyOnWrite<Entries> entries_;
 };
 
 }  // namespace leaflux

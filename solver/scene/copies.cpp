@@ -44,10 +44,10 @@ class Plants {
         organs.clear();
         ForEachFrameUnder(scene_, topology_, root, glm::dmat4(1.0),
                           [&](const Node& node, const glm::dmat4& frame) {
-                              if (!node.organ) return;
+                              if (!node.organ()) return;
                               const auto n =
                                   static_cast<std::uint32_t>(&node - scene_.nodes.data());
-                              organs.push_back({n, node.organ->mesh.get(), frame});
+                              organs.push_back({n, node.organ()->mesh.get(), frame});
                           });
         std::sort(organs.begin(), organs.end(),
                   [](const PlantOrgan& a, const PlantOrgan& b) { return a.node < b.node; });
@@ -60,7 +60,7 @@ class Plants {
         return receiverOf_[organs.front().node];
     }
     glm::dmat4 RootFrame(std::uint32_t root) const {
-        return glm::dmat4(scene_.nodes[root].parentFromLocal);
+        return glm::dmat4(scene_.nodes[root].parentFromLocal());
     }
 
   private:

@@ -67,7 +67,7 @@ struct Flattening {
 Receiver OrganReceiver(const Scene& scene, std::size_t n) {
     const Node& node = scene.nodes[n];
     return Receiver{ReceiverKind::kOrgan, static_cast<std::uint32_t>(n), node.id,
-                    scene.OpticsIndex(node.organ->opticsId)};
+                    scene.OpticsIndex(node.organ()->opticsId)};
 }
 
 // The receivers after the organs, in the flat scene's order — the environment's surfaces,
@@ -99,9 +99,9 @@ void ForEachSurfaceAndEmitter(const Scene& scene, const Visit& visit) {
 template <class Visit>
 void ForEachPlacedOrgan(const Scene& scene, const Visit& visit) {
     ForEachWorldFrame(scene, [&](const Node& node, const glm::dmat4& worldFromLocal) {
-        if (node.organ)
+        if (node.organ())
             visit(static_cast<std::size_t>(&node - scene.nodes.data()),
-                  PlaceMesh(*node.organ->mesh, worldFromLocal));
+                  PlaceMesh(*node.organ()->mesh, worldFromLocal));
     });
 }
 
@@ -135,7 +135,7 @@ std::vector<Triangle> PlaceMesh(const Mesh& mesh, const glm::dmat4& worldFromLoc
 FlatScene Flatten(const Scene& scene, const PlacedOrgans& placed) {
     Flattening out;
     for (std::size_t n = 0; n < scene.nodes.size(); ++n)
-        if (scene.nodes[n].organ) out.Add(placed(scene.nodes[n]), OrganReceiver(scene, n));
+        if (scene.nodes[n].organ()) out.Add(placed(scene.nodes[n]), OrganReceiver(scene, n));
     ForEachSurfaceAndEmitter(scene, [&](const std::vector<Triangle>& triangles,
                                         const auto& receiver) { out.Add(triangles, receiver()); });
     return out.Finish();
@@ -145,7 +145,7 @@ FlatScene Flatten(const Scene& scene) {
     const WorldFrames worldFromLocal(scene);
     std::vector<Triangle> placed;
     return Flatten(scene, [&](const Node& organ) -> const std::vector<Triangle>& {
-        placed = PlaceMesh(*organ.organ->mesh, worldFromLocal.at(organ.id));
+        placed = PlaceMesh(*organ.organ()->mesh, worldFromLocal.at(organ.id));
         return placed;
     });
 }
@@ -158,10 +158,10 @@ FlatScene ReceiversOf(const Scene& scene) {
         areas[n] = out.Bound(placed);
     });
     for (std::size_t n = 0; n < scene.nodes.size(); ++n) {
-        if (!scene.nodes[n].organ) continue;
+        if (!scene.nodes[n].organ()) continue;
         Receiver receiver = OrganReceiver(scene, n);
         receiver.areaM2 = areas[n];
-        out.Append(receiver, scene.nodes[n].organ->mesh->triangles.size());
+        out.Append(receiver, scene.nodes[n].organ()->mesh->triangles.size());
     }
     ForEachSurfaceAndEmitter(scene, [&](const std::vector<Triangle>& triangles,
                                         const auto& receiver) { out.Add(triangles, receiver()); });
@@ -170,7 +170,7 @@ FlatScene ReceiversOf(const Scene& scene) {
 
 const Mesh& ReceiverMesh(const Scene& scene, const Receiver& receiver) {
     if (receiver.kind == ReceiverKind::kOrgan)
-        return *scene.nodes.at(receiver.declared).organ->mesh;
+        return *scene.nodes.at(receiver.declared).organ()->mesh;
     if (receiver.kind == ReceiverKind::kEnvironment)
         return *scene.environment.at(receiver.declared).mesh;
     return *scene.sources.emitters.at(receiver.declared).mesh;  // an emitter, held or not
@@ -216,8 +216,8 @@ void PlaceVertices(const Scene& scene, const FlatScene& receivers,
     };
     // The organs by their world frames, not kept (ForEachWorldFrame); the others as declared.
     ForEachWorldFrame(scene, [&](const Node& node, const glm::dmat4& worldFromLocal) {
-        if (node.organ)
-            put(*node.organ->mesh, worldFromLocal,
+        if (node.organ())
+            put(*node.organ()->mesh, worldFromLocal,
                 receiverOf[static_cast<std::size_t>(&node - scene.nodes.data())]);
     });
     for (std::uint32_t r = 0; r < all.size(); ++r) {

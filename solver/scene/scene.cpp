@@ -87,7 +87,8 @@ class ReceiverNames {
   public:
     explicit ReceiverNames(const Scene& scene) : scene_(scene) {
         for (std::uint32_t i = 0; i < scene.nodes.size(); ++i) {
-            if (scene.nodes[i].organ) organs_.push_back({Hash(scene.NodeName(scene.nodes[i])), i});
+            if (scene.nodes[i].organ())
+                organs_.push_back({Hash(scene.NodeName(scene.nodes[i])), i});
         }
         std::sort(organs_.begin(), organs_.end());
     }
@@ -174,9 +175,9 @@ void ValidateTopology(const Scene& scene, ReceiverNames& names) {
     ForEachWorldFrame(scene, topology, [&](const Node& node, const glm::dmat4& worldFromLocal) {
         const auto i = static_cast<std::size_t>(&node - scene.nodes.data());
         reached[i] = 1;
-        if (!node.organ || (badMesh && *badMesh < i)) return;
+        if (!node.organ() || (badMesh && *badMesh < i)) return;
         try {
-            ValidateMesh(node.organ->mesh.get(), worldFromLocal, "organ.mesh", node.id);
+            ValidateMesh(node.organ()->mesh.get(), worldFromLocal, "organ.mesh", node.id);
         } catch (const InputError& e) {
             badMesh = i;
             meshError.emplace(e);
@@ -291,25 +292,25 @@ void ValidateMesh(const Mesh* mesh, const glm::dmat4& worldFromLocal, const std:
 void ValidateNode(const Scene& scene, const Node& node) {
     if (node.id == 0)
         throw InputError(ErrorCode::kInvalidArgument, "nodes.id", "0 is not a valid id");
-    if (!InvertibleFrame(node.parentFromLocal)) {
+    if (!InvertibleFrame(node.parentFromLocal())) {
         for (int c = 0; c < 4; ++c) {
             for (int r = 0; r < 3; ++r) {
-                if (!std::isfinite(node.parentFromLocal.At(c, r)))
+                if (!std::isfinite(node.parentFromLocal().At(c, r)))
                     throw InputError(ErrorCode::kInvalidArgument, "frame", "is not finite",
                                      node.id);
             }
         }
         throw InputError(ErrorCode::kDegenerate, "frame", "is singular", node.id);
     }
-    if (!std::isfinite(node.age))
+    if (!std::isfinite(node.age()))
         throw InputError(ErrorCode::kInvalidArgument, "age", "is not finite", node.id);
-    for (const auto& [key, value] : node.attributes) {
+    for (const auto& [key, value] : node.attributes()) {
         if (!std::isfinite(value)) {
             throw InputError(ErrorCode::kInvalidArgument, "attributes[" + key + "]",
                              "is not finite", node.id);
         }
     }
-    if (node.organ) RequireOptics(scene, node.organ->opticsId, "organ.optics", node.id);
+    if (node.organ()) RequireOptics(scene, node.organ()->opticsId, "organ.optics", node.id);
 }
 
 void ValidateSun(const Scene& scene, const Sun& sun, const std::string& field) {

@@ -26,8 +26,8 @@ SceneStore::SceneStore(Scene scene) : scene_(std::move(scene)) {
         Kept& kept = kept_[node.id];
         kept.at = i;
         kept.worldFromLocal = worldFromLocal.at(node.id);
-        if (node.organ) {
-            kept.mesh = node.organ->mesh;
+        if (node.organ()) {
+            kept.mesh = node.organ()->mesh;
             kept.placed = std::make_shared<const std::vector<Triangle>>(
                 PlaceMesh(*kept.mesh, kept.worldFromLocal));
             names_.emplace(scene_.NodeName(node), node.id);
@@ -140,15 +140,15 @@ SceneStore::Plan SceneStore::Check(const SceneChange& change) const {
                                                : plan.touched.count(node.parent)
                                                    ? plan.touched.at(node.parent).worldFromLocal
                                                    : kept_.at(node.parent).worldFromLocal;
-            plan.touched[*it].worldFromLocal = worldFromParent * glm::dmat4(node.parentFromLocal);
+            plan.touched[*it].worldFromLocal = worldFromParent * glm::dmat4(node.parentFromLocal());
         }
     }
     // Organs: checked and placed again unless mesh and world frame are as they were.
     for (NodeId id : moved) {
         const Node& node = *after(id);
-        if (!node.organ) continue;
+        if (!node.organ()) continue;
         Kept& kept = plan.touched.at(id);
-        kept.mesh = node.organ->mesh;
+        kept.mesh = node.organ()->mesh;
         const auto before = kept_.find(id);
         if (before != kept_.end() && !plan.removed.count(id) && before->second.mesh == kept.mesh &&
             before->second.worldFromLocal == kept.worldFromLocal) {
@@ -163,7 +163,7 @@ SceneStore::Plan SceneStore::Check(const SceneChange& change) const {
     std::unordered_set<std::string> claimed;
     for (NodeId id : plan.order) {
         const Node& node = *plan.changed.at(id);
-        if (!node.organ) continue;
+        if (!node.organ()) continue;
         const std::string name = scene_.NodeName(node);
         const auto held = names_.find(name);
         if (fixedNames_.count(name) || !claimed.insert(name).second ||
@@ -202,7 +202,7 @@ void SceneStore::Commit(Plan& plan, SceneChange& change) {
         }
     }
     const auto release = [&](const Node& node) {
-        if (node.organ) {
+        if (node.organ()) {
             const std::string name = scene_.NodeName(node);
             if (names_.at(name) == node.id) SetName(name, std::nullopt);
         }
@@ -246,7 +246,7 @@ void SceneStore::Commit(Plan& plan, SceneChange& change) {
     if (!plan.removed.empty()) Reindex();
     for (NodeId id : plan.order) {
         const Node& node = scene_.nodes[kept_.at(id).at];
-        if (node.organ) SetName(scene_.NodeName(node), id);
+        if (node.organ()) SetName(scene_.NodeName(node), id);
     }
 }
 

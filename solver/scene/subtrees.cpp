@@ -29,7 +29,7 @@ std::vector<Node> Rerooted(const Scene& scene, std::span<const std::size_t> indi
         Node node = scene.nodes[i];
         if (node.id == root) {
             node.parent = kNoParent;
-            node.parentFromLocal = rootFrame;
+            node.Edit().parentFromLocal = rootFrame;
         }
         nodes.push_back(std::move(node));
     }

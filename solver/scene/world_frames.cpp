@@ -46,7 +46,7 @@ void ForEachWorldFrame(const Scene& scene,
 void ForEachWorldFrame(const Scene& scene, const Topology& topology,
                        const std::function<void(const Node&, const glm::dmat4&)>& visit) {
     for (const std::uint32_t root : topology.Roots())
-        ForEachFrameUnder(scene, topology, root, glm::dmat4(scene.nodes[root].parentFromLocal),
+        ForEachFrameUnder(scene, topology, root, glm::dmat4(scene.nodes[root].parentFromLocal()),
                           visit);
 }
 
@@ -69,7 +69,7 @@ void ForEachFrameUnder(const Scene& scene, const Topology& topology, std::size_t
             // The parent's frame times this one's, as glm's product less the terms of the
             // fourth row, exact zeros.
             const glm::dmat4& parent = frames[depth - 1];
-            const Frame& local = node.parentFromLocal;
+            const Frame& local = node.parentFromLocal();
             glm::dmat4& frame = frames[depth];
             for (int c = 0; c < 3; ++c) {
                 frame[c] = parent[0] * local.At(c, 0) + parent[1] * local.At(c, 1) +

@@ -199,7 +199,7 @@ void WriteOpf(const std::string& path, long phytomers, long zeroLengthEvery = 0)
 long Triangles(const ImportedGeometry& g) {
     long count = 0;
     for (const Node& node : g.nodes)
-        count += node.organ ? static_cast<long>(node.organ->mesh->triangles.size()) : 0;
+        count += node.organ() ? static_cast<long>(node.organ()->mesh->triangles.size()) : 0;
     for (const Surface& s : g.environment) count += static_cast<long>(s.mesh->triangles.size());
     return count;
 }
@@ -224,7 +224,7 @@ Row Measure(const std::string& format, const std::string& path, Read read) {
             best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }
     long organs = 0;
-    for (const Node& node : g.nodes) organs += node.organ.has_value();
+    for (const Node& node : g.nodes) organs += node.organ().has_value();
     return {format,
             Triangles(g),
             organs,
