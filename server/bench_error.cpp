@@ -370,7 +370,7 @@ void Plot(const ErrorBenchOptions& options) {
 std::vector<NodeId> EvenlySpreadPlants(const Scene& scene, int count) {
     std::vector<NodeId> plants;
     for (const Node& node : scene.nodes)
-        if (node.type == NodeType::kPlant) plants.push_back(node.id);
+        if (node.type() == NodeType::kPlant) plants.push_back(node.id);
     std::sort(plants.begin(), plants.end());
     if (plants.size() < static_cast<std::size_t>(count)) {
         throw InputError(ErrorCode::kInvalidArgument, "--sample-plants",
@@ -412,7 +412,7 @@ int RunErrorBench(const ErrorBenchOptions& options) {
     const std::unordered_set<NodeId>* within = sample ? &*sample : nullptr;
     int leaves = 0;
     for (const Node& node : scene.nodes)
-        leaves += node.type == NodeType::kLeaf && (!within || within->count(node.id));
+        leaves += node.type() == NodeType::kLeaf && (!within || within->count(node.id));
     if (!ResetPeakRss()) {
         spdlog::warn(
             "the kernel does not let the peak memory be reset: each run's peak is the "

@@ -320,7 +320,7 @@ int RunGenerate(const GenerateCommand& command, std::uint64_t availableBytes) {
                large ? ProgressBar("writing") : std::function<void(double)>());
     std::size_t leaves = 0, triangles = 0;
     for (const Node& node : scene.nodes) {
-        leaves += node.type == NodeType::kLeaf;
+        leaves += node.type() == NodeType::kLeaf;
         if (node.organ()) triangles += node.organ()->mesh->triangles.size();
     }
     std::cout << "wrote " << command.out << ": " << leaves << " leaves, " << scene.nodes.size()

@@ -308,8 +308,8 @@ Node NodeFromProto(const v1::Node& in, const MeshLibrary& meshes) {
     Node node;
     node.id = in.id();
     node.parent = in.parent();
-    node.type = TypeFromProto(in.type());
-    node.name = in.name();
+    node.Edit().type = TypeFromProto(in.type());
+    node.Edit().name = in.name();
     node.Edit().parentFromLocal = FrameFromProto(in.frame(), "frame", in.id());
     node.Edit().age = in.age();
     node.Edit().attributes.insert(in.attributes().begin(), in.attributes().end());

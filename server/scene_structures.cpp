@@ -24,7 +24,6 @@ std::string StructureField(const std::string& name) { return "structures[" + nam
 struct ParsedStructure {
     const v1::Structure* message = nullptr;
     std::vector<Node> nodes;
-    std::vector<bool> nameHasId;  // per node: its name holds "{id}"
 };
 
 ParsedStructure Parse(const std::string& name, const v1::Structure& message,
@@ -49,7 +48,9 @@ ParsedStructure Parse(const std::string& name, const v1::Structure& message,
                              "local id " + std::to_string(in.id()) + " is used by two nodes",
                              in.id());
         }
-        parsed.nameHasId.push_back(in.name().find("{id}") != std::string::npos);
+        // Every copy's name from one pattern (NodeBody::nameHasId), not a string of its own.
+        if (in.name().find("{id}") != std::string::npos)
+            parsed.nodes.back().Edit().nameHasId = true;
     }
     for (const Node& node : parsed.nodes) {
         if (node.parent != kNoParent && !ids.count(node.parent)) {
@@ -70,23 +71,107 @@ ParsedStructure Parse(const std::string& name, const v1::Structure& message,
     return parsed;
 }
 
-std::string WithId(std::string name, NodeId id) {
-    const std::string digits = std::to_string(id);
-    for (std::size_t at = name.find("{id}"); at != std::string::npos;
-         at = name.find("{id}", at + digits.size())) {
-        name.replace(at, 4, digits);
-    }
-    return name;
-}
-
 // One placement to expand: a structure, the offset of its ids, where its roots hang.
 struct Job {
     const std::string* structure;
+    const v1::Placement* placement;  // the message placing it
     NodeId offset;
     NodeId rootParent;
     glm::dmat4 rootFrame;
     std::string field;  // the placement, for errors
 };
+
+// Every node of the scene's placements, appended to `nodes`. With `used` (the ids taken so
+// far), a placed id already taken throws, naming the placement; without, ids are not checked.
+void Expand(const v1::Scene& message, const MeshLibrary& meshes, std::vector<Node>& nodes,
+            std::unordered_set<NodeId>* used) {
+    std::unordered_map<std::string, ParsedStructure> parsed;
+    auto structureNamed = [&](const std::string& name) -> const ParsedStructure& {
+        auto it = parsed.find(name);
+        if (it == parsed.end()) {
+            it = parsed.emplace(name, Parse(name, message.structures().at(name), meshes)).first;
+        }
+        return it->second;
+    };
+    // The roots a placement made last, by (placement, root): a placement inside a structure
+    // makes the same roots, at the same frame, in every copy of that structure (a branch in
+    // each of 233 copies of a tree), and they share one body.
+    struct Made {
+        bool any = false;
+        glm::dmat4 frame{1.0};
+        Node root;
+    };
+    std::map<std::pair<const v1::Placement*, std::size_t>, Made> roots;
+    std::vector<Job> jobs;
+    for (int i = 0; i < message.placements_size(); ++i) {
+        const v1::Placement& p = message.placements(i);
+        const std::string field = "placements[" + std::to_string(i) + "]";
+        jobs.push_back({&p.structure(), &p, p.id_offset(), p.parent(),
+                        FrameFromProto(p.frame(), field + ".frame"), field});
+    }
+    constexpr NodeId kMaxId = std::numeric_limits<NodeId>::max();
+    while (!jobs.empty()) {
+        const Job job = std::move(jobs.back());
+        jobs.pop_back();
+        const ParsedStructure& s = structureNamed(*job.structure);
+        auto placed = [&](NodeId local) {
+            if (local > kMaxId - job.offset) {
+                throw InputError(ErrorCode::kInvalidArgument, job.field + ".id_offset",
+                                 "places local id " + std::to_string(local) + " of structure '" +
+                                     *job.structure + "' past the largest id");
+            }
+            return local + job.offset;
+        };
+        for (std::size_t k = 0; k < s.nodes.size(); ++k) {
+            Node node = s.nodes[k];
+            const NodeId local = node.id;
+            node.id = placed(local);
+            if (used && !used->insert(node.id).second) {
+                throw InputError(ErrorCode::kAlreadyExists, job.field + ".id_offset",
+                                 "places node " + std::to_string(local) + " of structure '" +
+                                     *job.structure + "' at id " + std::to_string(node.id) +
+                                     ", which another node already has",
+                                 node.id);
+            }
+            if (node.parent != kNoParent) {
+                node.parent = placed(node.parent);
+                nodes.push_back(std::move(node));
+                continue;
+            }
+            Made& made = roots[{job.placement, k}];
+            if (!made.any || made.frame != job.rootFrame) {
+                made.any = true;
+                made.frame = job.rootFrame;
+                made.root = s.nodes[k];
+                if (made.root.parentFromLocal() == Frame()) {
+                    made.root.Edit().parentFromLocal = job.rootFrame;  // exact: no product
+                } else {
+                    made.root.Edit().parentFromLocal =
+                        job.rootFrame * glm::dmat4(made.root.parentFromLocal());
+                }
+            }
+            node = made.root;
+            node.id = local + job.offset;
+            node.parent = job.rootParent;
+            nodes.push_back(std::move(node));
+        }
+        for (int k = 0; k < s.message->placements_size(); ++k) {
+            const v1::Placement& q = s.message->placements(k);
+            const std::string field =
+                StructureField(*job.structure) + ".placements[" + std::to_string(k) + "]";
+            const glm::dmat4 frame = FrameFromProto(q.frame(), field + ".frame");
+            if (q.id_offset() > kMaxId - job.offset) {
+                throw InputError(ErrorCode::kInvalidArgument, field + ".id_offset",
+                                 "with the offset of " + job.field + ", passes the largest id");
+            }
+            const bool atRoot = q.parent() == kNoParent;
+            jobs.push_back({&q.structure(), &q, job.offset + q.id_offset(),
+                            atRoot ? job.rootParent : placed(q.parent()),
+                            atRoot ? job.rootFrame * frame : frame,
+                            field + " (in " + job.field + ")"});
+        }
+    }
+}
 
 }  // namespace
 
@@ -160,81 +245,20 @@ std::size_t CountPlacedNodes(const v1::Scene& message, std::size_t topLevelNodes
 void ExpandPlacements(const v1::Scene& message, const MeshLibrary& meshes,
                       std::vector<Node>& nodes) {
     if (message.placements_size() == 0) return;
-    std::unordered_map<std::string, ParsedStructure> parsed;
-    auto structureNamed = [&](const std::string& name) -> const ParsedStructure& {
-        auto it = parsed.find(name);
-        if (it == parsed.end()) {
-            it = parsed.emplace(name, Parse(name, message.structures().at(name), meshes)).first;
-        }
-        return it->second;
-    };
-    std::unordered_set<NodeId> used;
-    used.reserve(nodes.size());
-    for (const Node& node : nodes) used.insert(node.id);
-    std::vector<Job> jobs;
-    for (int i = 0; i < message.placements_size(); ++i) {
-        const v1::Placement& p = message.placements(i);
-        const std::string field = "placements[" + std::to_string(i) + "]";
-        jobs.push_back({&p.structure(), p.id_offset(), p.parent(),
-                        FrameFromProto(p.frame(), field + ".frame"), field});
-    }
-    constexpr NodeId kMaxId = std::numeric_limits<NodeId>::max();
-    while (!jobs.empty()) {
-        const Job job = std::move(jobs.back());
-        jobs.pop_back();
-        const ParsedStructure& s = structureNamed(*job.structure);
-        auto placed = [&](NodeId local) {
-            if (local > kMaxId - job.offset) {
-                throw InputError(ErrorCode::kInvalidArgument, job.field + ".id_offset",
-                                 "places local id " + std::to_string(local) + " of structure '" +
-                                     *job.structure + "' past the largest id");
-            }
-            return local + job.offset;
-        };
-        for (std::size_t k = 0; k < s.nodes.size(); ++k) {
-            Node node = s.nodes[k];
-            const NodeId local = node.id;
-            node.id = placed(local);
-            if (!used.insert(node.id).second) {
-                throw InputError(ErrorCode::kAlreadyExists, job.field + ".id_offset",
-                                 "places node " + std::to_string(local) + " of structure '" +
-                                     *job.structure + "' at id " + std::to_string(node.id) +
-                                     ", which another node already has",
-                                 node.id);
-            }
-            if (node.parent == kNoParent) {
-                node.parent = job.rootParent;
-                if (node.parentFromLocal() == Frame()) {
-                    node.Edit().parentFromLocal = job.rootFrame;  // exact: no product with identity
-                } else {
-                    node.Edit().parentFromLocal =
-                        job.rootFrame * glm::dmat4(node.parentFromLocal());
-                }
-            } else {
-                node.parent = placed(node.parent);
-            }
-            if (s.nameHasId[k]) node.name = WithId(node.name, node.id);
-            nodes.push_back(std::move(node));
-        }
-        for (int k = 0; k < s.message->placements_size(); ++k) {
-            const v1::Placement& q = s.message->placements(k);
-            const std::string field =
-                StructureField(*job.structure) + ".placements[" + std::to_string(k) + "]";
-            const glm::dmat4 frame = FrameFromProto(q.frame(), field + ".frame");
-            if (q.id_offset() > kMaxId - job.offset) {
-                throw InputError(ErrorCode::kInvalidArgument, field + ".id_offset",
-                                 "with the offset of " + job.field + ", passes the largest id");
-            }
-            const bool atRoot = q.parent() == kNoParent;
-            jobs.push_back({&q.structure(), job.offset + q.id_offset(),
-                            atRoot ? job.rootParent : placed(q.parent()),
-                            atRoot ? job.rootFrame * frame : frame,
-                            field + " (in " + job.field + ")"});
-        }
-    }
-    // In place: the ids are unique (`used`), so no order of equals to keep, and no buffer of
-    // half the nodes as a stable sort takes (80 MB for 233 placed trees).
+    std::vector<NodeId> own;
+    own.reserve(nodes.size());
+    for (const Node& node : nodes) own.push_back(node.id);
+    Expand(message, meshes, nodes, nullptr);
     std::sort(nodes.begin(), nodes.end(), [](const Node& a, const Node& b) { return a.id < b.id; });
+    const auto same = [](const Node& a, const Node& b) { return a.id == b.id; };
+    if (std::adjacent_find(nodes.begin(), nodes.end(), same) == nodes.end()) return;
+    // An id twice: expanded again, each id checked as it is placed, to name the placement that
+    // placed it a second time (a hash set of every id while expanding cost 24 bytes a node,
+    // freed in pieces among the bodies kept: 100 MB of the paper's plantation stayed
+    // resident). Twice among the scene's own nodes instead, Scene::Validate names it.
+    std::unordered_set<NodeId> used(own.begin(), own.end());
+    std::vector<Node> again;
+    Expand(message, meshes, again, &used);
 }
 
 // ---- Writing --------------------------------------------------------------------------
@@ -272,7 +296,7 @@ void WriteNode(const Node& node, NodeId id, NodeId parent, const std::string& na
                MeshWriter& meshes, v1::Node* out) {
     out->set_id(id);
     out->set_parent(parent);
-    out->set_type(TypeToProto(node.type));
+    out->set_type(TypeToProto(node.type()));
     out->set_name(name);
     if (withFrame) FrameToProto(node.parentFromLocal(), out->mutable_frame());
     out->set_age(node.age());
@@ -284,13 +308,14 @@ void WriteNode(const Node& node, NodeId id, NodeId parent, const std::string& na
 // generated) becomes "leaf{id}"; others stay. `shareable` is false for a name that already
 // holds "{", which a structure would rewrite.
 std::string NameTemplate(const Node& node, bool& shareable) {
-    shareable = node.name.find('{') == std::string::npos;
+    const std::string name = node.name();
+    shareable = name.find('{') == std::string::npos;
     const std::string digits = std::to_string(node.id);
-    if (node.name.size() > digits.size() &&
-        node.name.compare(node.name.size() - digits.size(), digits.size(), digits) == 0) {
-        return node.name.substr(0, node.name.size() - digits.size()) + "{id}";
+    if (name.size() > digits.size() &&
+        name.compare(name.size() - digits.size(), digits.size(), digits) == 0) {
+        return name.substr(0, name.size() - digits.size()) + "{id}";
     }
-    return node.name;
+    return name;
 }
 
 std::uint64_t Bits(double value) {
@@ -385,7 +410,7 @@ class InstancedWriter {
     int ClassOf(std::size_t i, std::map<ClassKey, int>& classes) {
         const Node& node = nodes_[i];
         ClassKey key;
-        key.type = static_cast<int>(node.type);
+        key.type = static_cast<int>(node.type());
         key.age = Bits(node.age());
         for (const auto& [name, value] : node.attributes())
             key.attributes.push_back({name, Bits(value)});
@@ -429,8 +454,8 @@ class InstancedWriter {
             if (!root && Shared(c)) {
                 ClassInfo& info = info_[c];
                 if (info.structure.empty()) {
-                    info.structure =
-                        std::string(NodeTypeName(node.type)) + "_" + std::to_string(structures_++);
+                    info.structure = std::string(NodeTypeName(node.type())) + "_" +
+                                     std::to_string(structures_++);
                     pending_.push_back(c);
                 }
                 v1::Placement* p =
@@ -442,7 +467,7 @@ class InstancedWriter {
                 continue;
             }
             bool shareable = true;
-            const std::string name = structure ? NameTemplate(node, shareable) : node.name;
+            const std::string name = structure ? NameTemplate(node, shareable) : node.name();
             WriteNode(node, node.id - base, parent, name, !root, meshes_,
                       structure ? structure->add_nodes() : message_.add_nodes());
             for (auto k = children_[i].rbegin(); k != children_[i].rend(); ++k) stack.push_back(*k);
@@ -469,7 +494,7 @@ void WriteInstancedNodes(const Scene& scene, v1::Scene& message) {
 void WriteFlatNodes(const Scene& scene, v1::Scene& message) {
     MeshWriter meshes(scene, message);
     for (const Node& node : scene.nodes) {
-        WriteNode(node, node.id, node.parent, node.name, true, meshes, message.add_nodes());
+        WriteNode(node, node.id, node.parent, node.name(), true, meshes, message.add_nodes());
     }
 }
 

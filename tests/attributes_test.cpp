@@ -71,10 +71,10 @@ TEST(Attributes, CopiesAreValues) {
     EXPECT_EQ(none.count("height"), 0u);
 }
 
-TEST(Attributes, CopiesShareTheirEntriesUntilOneChanges) {
+TEST(Attributes, CopiesKeepTheirEntriesWhenOneChanges) {
     Attributes original;
     original["length_m"] = 0.1;
-    const Attributes copy = original;  // shared, as a placed structure's nodes are
+    const Attributes copy = original;
     Attributes changed = original;
     changed["length_m"] = 0.2;
     changed["order"] = 1;

@@ -96,7 +96,7 @@ TEST(Copies, TheOriginalIsTheFirstInTheReceiversOrder) {
     for (const NodeId root : {1, 2}) {
         Node plant;
         plant.id = root;
-        plant.type = NodeType::kPlant;
+        plant.Edit().type = NodeType::kPlant;
         plant.Edit().parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(root, 0.0, 0.0));
         scene.nodes.push_back(plant);
     }

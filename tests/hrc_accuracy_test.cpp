@@ -389,8 +389,8 @@ Scene DenseCrown(int leaves, std::uint64_t seed) {
     scene.nodes.push_back(OrganNode(1, "disc", Disc(1.0, 0.0, false, 64), "leaf"));
     Node crown;
     crown.id = 2;
-    crown.type = NodeType::kPlant;
-    crown.name = "crown";
+    crown.Edit().type = NodeType::kPlant;
+    crown.Edit().name = "crown";
     scene.nodes.push_back(crown);
     const double side = std::sqrt(5.0 * testing::kPi / leaves);
     Random random(seed);

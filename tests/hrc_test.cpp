@@ -63,7 +63,7 @@ TEST(HrcStem, AStripIsLitOnBothSidesAndATubeOnlyOutside) {
     Scene scene = OneBandScene({{"stem", Opaque(0.0)}});
     auto internode = [&](NodeId id, const std::string& name, std::shared_ptr<const Mesh> mesh) {
         Node node = OrganNode(id, name, std::move(mesh), "stem");
-        node.type = NodeType::kInternode;
+        node.Edit().type = NodeType::kInternode;
         scene.nodes.push_back(node);
     };
     // A strip facing east (+x) at x = 0, and a 10 cm square tube 1 m south of it.
@@ -121,7 +121,7 @@ TEST(HrcStem, LeavesAroundATubeDoNotLightItsInside) {
         tube->triangles.push_back({i, j + 4, i + 4});
     }
     Node stem = OrganNode(1, "tube", tube, "stem");
-    stem.type = NodeType::kInternode;
+    stem.Edit().type = NodeType::kInternode;
     scene.nodes.push_back(stem);
     Random random(5);
     for (int i = 0; i < 60; ++i) {  // 8 cm leaves 0.2 to 0.5 m from the tube's axis
@@ -480,8 +480,8 @@ TEST(HrcTree, LinkAuditFindsTheLightThatDoesNotEscapeCoveredOnce) {
 void AddStackedPlant(Scene& scene, const std::string& topOptics, const std::string& bottomOptics) {
     Node plant;
     plant.id = 10;
-    plant.type = NodeType::kPlant;
-    plant.name = "plant";
+    plant.Edit().type = NodeType::kPlant;
+    plant.Edit().name = "plant";
     scene.nodes.push_back(plant);
     scene.nodes.push_back(OrganNode(1, "top", Rectangle(0.2, 0.2, 1.1), topOptics, 10));
     scene.nodes.push_back(OrganNode(2, "bottom", Rectangle(0.2, 0.2, 1.0), bottomOptics, 10));

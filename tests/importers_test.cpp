@@ -30,8 +30,8 @@ TEST(ReadObj, ReadsEachLeafPrototypeAsOneNamedOrgan) {
     for (const char* file : {"AlmondLeaf.obj", "BindweedLeaf.obj", "RedbudLeaf.obj"}) {
         const ImportedGeometry g = ReadObj(Data(std::string("leaves/") + file));
         ASSERT_EQ(g.nodes.size(), 1u) << file;
-        EXPECT_EQ(g.nodes[0].name, "leaf");
-        EXPECT_EQ(g.nodes[0].type, NodeType::kLeaf);
+        EXPECT_EQ(g.nodes[0].name(), "leaf");
+        EXPECT_EQ(g.nodes[0].type(), NodeType::kLeaf);
         EXPECT_FALSE(g.nodes[0].organ()->opticsId.empty());
         EXPECT_GT(MeshArea(*g.nodes[0].organ()->mesh, glm::dmat4(1.0)), 0.0);
     }
@@ -47,11 +47,11 @@ TEST(ReadObj, SplitsGroupsAndMaterials) {
                       "g blade\nusemtl green\nf 1 3 4\nusemtl yellow\nf -4 -3 -1\n");
     const ImportedGeometry g = ReadObj(path);
     ASSERT_EQ(g.nodes.size(), 3u);
-    EXPECT_EQ(g.nodes[0].name, "stem");
+    EXPECT_EQ(g.nodes[0].name(), "stem");
     EXPECT_EQ(g.nodes[0].organ()->opticsId, "bark");
-    EXPECT_EQ(g.nodes[0].type, NodeType::kInternode);
+    EXPECT_EQ(g.nodes[0].type(), NodeType::kInternode);
     EXPECT_EQ(g.nodes[1].organ()->opticsId, "green");
-    EXPECT_EQ(g.nodes[2].name, "blade/yellow");
+    EXPECT_EQ(g.nodes[2].name(), "blade/yellow");
 }
 
 TEST(ReadObj, RejectsBadFacesWithFileAndLine) {
@@ -71,7 +71,7 @@ TEST(ReadCan, DecodesLabelsOfTheSeedlingTray) {
     EXPECT_EQ(TriangleCount(g), 2270);
     int plants = 0, species1 = 0, species2 = 0;
     for (const Node& node : g.nodes) {
-        plants += node.type == NodeType::kPlant;
+        plants += node.type() == NodeType::kPlant;
         if (!node.organ()) continue;
         EXPECT_NE(node.parent, kNoParent);
         species1 += node.organ()->opticsId.str().rfind("species1", 0) == 0;
@@ -127,7 +127,7 @@ TEST(ReadOpf, KeepsSharedMeshesAndTheTopology) {
     for (const Node& node : g.nodes) {
         if (!node.organ()) continue;
         ++organs;
-        leaves += node.type == NodeType::kLeaf;
+        leaves += node.type() == NodeType::kLeaf;
         meshes.insert(node.organ()->mesh.get());
     }
     EXPECT_EQ(organs, 4);

@@ -55,7 +55,7 @@ NodeId LargestBranch(const Scene& scene, NodeId plant) {
     NodeId best = 0;
     std::size_t most = 0;
     for (const Node& node : scene.nodes) {
-        if (node.type != NodeType::kAxis || node.parent == plant ||
+        if (node.type() != NodeType::kAxis || node.parent == plant ||
             !Under(scene, plant).count(node.id))
             continue;
         if (const std::size_t size = Under(scene, node.id).size(); size > most)

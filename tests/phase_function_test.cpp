@@ -28,7 +28,7 @@ Scene LeafCloud(int n, double side, double edge, std::uint64_t seed, BandOptics 
     scene.optics = {{"leaf", {optics}}};
     Node plant;
     plant.id = 1;
-    plant.type = NodeType::kPlant;
+    plant.Edit().type = NodeType::kPlant;
     scene.nodes.push_back(plant);
     Random random(seed);
     for (int i = 0; i < n; ++i) {

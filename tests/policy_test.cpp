@@ -403,7 +403,7 @@ std::unordered_map<NodeId, std::int64_t> LeavesByWalkingUp(const Scene& scene) {
     for (const Node& node : scene.nodes) byId[node.id] = &node;
     std::unordered_map<NodeId, std::int64_t> leaves;
     for (const Node& node : scene.nodes) {
-        if (node.type != NodeType::kLeaf || !node.organ()) continue;
+        if (node.type() != NodeType::kLeaf || !node.organ()) continue;
         for (const Node* n = &node; n; n = n->parent ? byId.at(n->parent) : nullptr) {
             ++leaves[n->id];
         }
@@ -420,7 +420,7 @@ TEST(SignatureOnGeneratedTree, EveryLeafBearingStructureHasOne) {
     for (const Node& node : scene.nodes) {
         const auto found = leaves.find(node.id);
         const StructureSignature* s = signatures.Find(node.id);
-        if (!policy.IsInstanceType(node.type) || found == leaves.end()) {
+        if (!policy.IsInstanceType(node.type()) || found == leaves.end()) {
             EXPECT_EQ(s, nullptr) << scene.NodeName(node);
             continue;
         }

@@ -64,8 +64,8 @@ inline Node OrganNode(NodeId id, const std::string& name, std::shared_ptr<const 
     Node node;
     node.id = id;
     node.parent = parent;
-    node.type = NodeType::kLeaf;
-    node.name = name;
+    node.Edit().type = NodeType::kLeaf;
+    node.Edit().name = name;
     node.Edit().organ = leaflux::Organ{std::move(mesh), optics};
     return node;
 }

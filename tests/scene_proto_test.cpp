@@ -63,7 +63,7 @@ TEST(SceneFile, RoundTripsAGeneratedTreeKeepingSharedMeshes) {
     for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
         EXPECT_EQ(back.nodes[i].id, scene.nodes[i].id);
         EXPECT_EQ(back.nodes[i].parent, scene.nodes[i].parent);
-        EXPECT_EQ(back.nodes[i].type, scene.nodes[i].type);
+        EXPECT_EQ(back.nodes[i].type(), scene.nodes[i].type());
         for (int c = 0; c < 4; ++c) {
             for (int r = 0; r < 3; ++r) {
                 EXPECT_DOUBLE_EQ(back.nodes[i].parentFromLocal().At(c, r),

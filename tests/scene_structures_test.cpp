@@ -70,8 +70,8 @@ void ExpectSameNodes(const Scene& a, const Scene& b) {
         const Node &x = a.nodes[i], &y = b.nodes[i];
         ASSERT_EQ(x.id, y.id) << "node " << i;
         EXPECT_EQ(x.parent, y.parent) << "node " << x.id;
-        EXPECT_EQ(x.type, y.type) << "node " << x.id;
-        EXPECT_EQ(x.name, y.name) << "node " << x.id;
+        EXPECT_EQ(x.type(), y.type()) << "node " << x.id;
+        EXPECT_EQ(x.name(), y.name()) << "node " << x.id;
         EXPECT_TRUE(SameBits(x.parentFromLocal(), y.parentFromLocal())) << "node " << x.id;
         EXPECT_EQ(x.age(), y.age()) << "node " << x.id;
         EXPECT_EQ(x.attributes(), y.attributes()) << "node " << x.id;
@@ -116,7 +116,7 @@ Below Describe(const Scene& scene, NodeId top) {
     while (!stack.empty()) {
         const auto [node, topFromLocal] = stack.back();
         stack.pop_back();
-        below.types.push_back(node->type);
+        below.types.push_back(node->type());
         below.attributes.push_back(node->attributes());
         if (node->organ()) {
             below.topFromOrgan.push_back(topFromLocal);
@@ -142,7 +142,7 @@ bool ExactCopies(const Below& a, const Below& b) {
 std::map<std::pair<int, std::size_t>, std::vector<NodeId>> AxesByClass(const Scene& scene) {
     std::map<std::pair<int, std::size_t>, std::vector<NodeId>> classes;
     for (const Node& node : scene.nodes) {
-        if (node.type != NodeType::kAxis || node.attributes().at("order") < 1) continue;
+        if (node.type() != NodeType::kAxis || node.attributes().at("order") < 1) continue;
         std::size_t leaves = 0;
         for (NodeType type : Describe(scene, node.id).types) leaves += type == NodeType::kLeaf;
         classes[{static_cast<int>(node.attributes().at("order")), leaves}].push_back(node.id);
@@ -158,7 +158,7 @@ TEST(GeneratorCopies, LateralAxesOfOneOrderAndSizeAreExactCopies) {
     AddTree(scene, tree, {1, 2, 0});
     scene.Validate();
     std::size_t leaves = 0;
-    for (const Node& node : scene.nodes) leaves += node.type == NodeType::kLeaf;
+    for (const Node& node : scene.nodes) leaves += node.type() == NodeType::kLeaf;
     EXPECT_EQ(leaves, 2000u);
     const auto frames = WorldFromLocal(scene);
     std::size_t compared = 0;
@@ -199,7 +199,7 @@ TEST(GeneratorCopies, KeepsTheLeafCountAndTheDefaultTree) {
         AddTree(scene, tree, {0, 0, 0});
         scene.Validate();
         int leaves = 0;
-        for (const Node& node : scene.nodes) leaves += node.type == NodeType::kLeaf;
+        for (const Node& node : scene.nodes) leaves += node.type() == NodeType::kLeaf;
         EXPECT_EQ(leaves, count);
     }
     // The default tree, as every table was measured on: a digest of its nodes' frames.
@@ -228,7 +228,7 @@ TEST(GeneratorCopies, PlantationTreesAreCopiesOfPrototypes) {
     scene.Validate();
     std::vector<NodeId> plants;
     for (const Node& node : scene.nodes) {
-        if (node.type == NodeType::kPlant) plants.push_back(node.id);
+        if (node.type() == NodeType::kPlant) plants.push_back(node.id);
     }
     ASSERT_EQ(plants.size(), 5u);
     const Below first = Describe(scene, plants[0]), second = Describe(scene, plants[1]);
@@ -271,16 +271,16 @@ TEST(InstancedSceneFile, RoundTripsTheDefaultPlantationAndAHandMadeScene) {
     for (NodeId plant : {50, 10}) {
         Node p;
         p.id = plant;
-        p.type = NodeType::kPlant;
-        p.name = "tree";
+        p.Edit().type = NodeType::kPlant;
+        p.Edit().name = "tree";
         p.Edit().parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(plant * 0.1, 0, 0));
         hand.nodes.push_back(p);
         for (NodeId k : {3, 1, 2}) {
             Node l;
             l.id = plant - k;
             l.parent = plant;
-            l.type = NodeType::kLeaf;
-            l.name = "leaf" + std::to_string(l.id);
+            l.Edit().type = NodeType::kLeaf;
+            l.Edit().name = "leaf" + std::to_string(l.id);
             l.Edit().parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0, 0.1 * k));
             l.Edit().organ = Organ{leaf, "leaf"};
             hand.nodes.push_back(l);
@@ -348,9 +348,9 @@ placements { structure: "plant" id_offset: 200 }
     for (const Node& node : scene.nodes) byId[node.id] = &node;
     ASSERT_TRUE(byId.count(101) && byId.count(103) && byId.count(206));
     EXPECT_EQ(byId[101]->parent, 1u);
-    EXPECT_EQ(byId[101]->name, "plant101");
+    EXPECT_EQ(byId[101]->name(), "plant101");
     EXPECT_EQ(byId[104]->parent, 101u);
-    EXPECT_EQ(byId[105]->name, "leaf105");
+    EXPECT_EQ(byId[105]->name(), "leaf105");
     EXPECT_EQ(byId[105]->parent, 104u);
     EXPECT_EQ(byId[106]->parent, 1u);  // parent 0 in "plant": hangs where the plant does
     EXPECT_EQ(byId[201]->parent, 0u);
@@ -371,9 +371,14 @@ placements { structure: "plant" id_offset: 200 }
 )");
     std::map<NodeId, Node*> byId;
     for (Node& node : scene.nodes) byId[node.id] = &node;
-    ASSERT_TRUE(byId.count(105) && byId.count(205) && byId.count(101) && byId.count(201));
+    for (const NodeId id : {101, 104, 105, 106, 201, 204, 205, 206}) ASSERT_TRUE(byId.count(id));
     EXPECT_TRUE(byId[105]->SharesBodyWith(*byId[205]));   // the leaf: held once
     EXPECT_FALSE(byId[101]->SharesBodyWith(*byId[201]));  // a root moved by its placement
+    // A shoot placed inside the plant: the same root at the same frame in both copies.
+    EXPECT_TRUE(byId[104]->SharesBodyWith(*byId[204]));
+    // A shoot placed at the plant's root: moved by each plant's placement.
+    EXPECT_FALSE(byId[106]->SharesBodyWith(*byId[206]));
+    EXPECT_NE(glm::dmat4(byId[106]->parentFromLocal()), glm::dmat4(byId[206]->parentFromLocal()));
     const glm::dmat4 before(byId[205]->parentFromLocal());
     byId[105]->Edit().parentFromLocal = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 0, 9));
     byId[105]->Edit().organ->opticsId = "bark";

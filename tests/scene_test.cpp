@@ -24,7 +24,7 @@ Scene ValidScene() {
     Scene scene = OneBandScene({{"leaf", Leaf(0.1, 0.05)}, {"soil", Opaque(0.2)}});
     Node plant;
     plant.id = 1;
-    plant.type = NodeType::kPlant;
+    plant.Edit().type = NodeType::kPlant;
     scene.nodes.push_back(plant);
     scene.nodes.push_back(OrganNode(2, "leaf2", Rectangle(0.1, 0.05, 1.0), "leaf", 1));
     scene.environment.push_back({"ground", Rectangle(4, 4, 0), "soil"});
@@ -332,7 +332,7 @@ TEST(Scene, NamesTheFirstFailingOrganInTheNodesOrder) {
     // Leaf 4 whole: the name.
     scene.nodes[1].Edit().organ->mesh = Rectangle(0.1, 0.05, 3.0);
     EXPECT_EQ(errorOf(scene), std::pair(ErrorCode::kAlreadyExists, std::optional<NodeId>(5)));
-    scene.nodes[3].name = "leaf5";
+    scene.nodes[3].Edit().name = "leaf5";
     EXPECT_NO_THROW(scene.Validate());
 }
 
@@ -411,10 +411,10 @@ TEST(SceneStore, FlattensAsTheWholeSceneAfterEachChange) {
     SceneStore store(start);
     ExpectSameFlat(store.Flat(), Flatten(store.Get()));
     const auto isAxis = [](const Node& n) {
-        return n.type == NodeType::kAxis && n.attributes().at("order") == 1.0;  // a branch
+        return n.type() == NodeType::kAxis && n.attributes().at("order") == 1.0;  // a branch
     };
-    const auto isPhytomer = [](const Node& n) { return n.type == NodeType::kPhytomer; };
-    const auto isLeaf = [](const Node& n) { return n.type == NodeType::kLeaf; };
+    const auto isPhytomer = [](const Node& n) { return n.type() == NodeType::kPhytomer; };
+    const auto isLeaf = [](const Node& n) { return n.type() == NodeType::kLeaf; };
 
     SceneChange cut;
     cut.removed.push_back(FindNode(store.Get(), isAxis).id);
@@ -452,7 +452,7 @@ TEST(SceneStore, FlattensAsTheWholeSceneAfterEachChange) {
 TEST(SceneStore, ChecksTheOrgansAChangeMoves) {
     SceneStore store(GrownTree());
     const Node& leaf =
-        FindNode(store.Get(), [](const Node& n) { return n.type == NodeType::kLeaf; });
+        FindNode(store.Get(), [](const Node& n) { return n.type() == NodeType::kLeaf; });
     Node phytomer = FindNode(store.Get(), [&](const Node& n) { return n.id == leaf.parent; });
     ASSERT_FALSE(phytomer.organ().has_value());
     phytomer.Edit().parentFromLocal =
@@ -474,10 +474,10 @@ TEST(SceneStore, ChecksTheOrgansAChangeMoves) {
 TEST(SceneStore, RejectsWhatWholeValidationRejects) {
     const Scene start = GrownTree();
     SceneStore store(start);
-    const Node& leaf = FindNode(start, [](const Node& n) { return n.type == NodeType::kLeaf; });
-    const Node& axis = FindNode(start, [](const Node& n) { return n.type == NodeType::kAxis; });
+    const Node& leaf = FindNode(start, [](const Node& n) { return n.type() == NodeType::kLeaf; });
+    const Node& axis = FindNode(start, [](const Node& n) { return n.type() == NodeType::kAxis; });
     const Node& branch = FindNode(
-        start, [&](const Node& n) { return n.type == NodeType::kAxis && n.id != axis.id; });
+        start, [&](const Node& n) { return n.type() == NodeType::kAxis && n.id != axis.id; });
     const auto expect = [&](SceneChange change, ErrorCode code, NodeId node) {
         Scene whole = start;  // the same change, made to a copy and validated whole
         std::erase_if(whole.nodes, [&](const Node& n) {
@@ -554,7 +554,7 @@ TEST(SceneStore, UndoRestoresTheSceneBefore) {
     const auto nth = [&](NodeType type, int k) {
         std::vector<const Node*> found;
         for (const Node& n : store.Get().nodes) {
-            if (n.type == type) found.push_back(&n);
+            if (n.type() == type) found.push_back(&n);
         }
         return *found.at(k);
     };
@@ -565,7 +565,7 @@ TEST(SceneStore, UndoRestoresTheSceneBefore) {
         glm::rotate(glm::dmat4(bent.parentFromLocal()), 0.2, glm::dvec3(0, 1, 0));
     change.updated.push_back(bent);
     Node renamed = nth(NodeType::kLeaf, 0);
-    renamed.name = "renamed";
+    renamed.Edit().name = "renamed";
     change.updated.push_back(renamed);
     change.added.push_back(OrganNode(9001, "new", Rectangle(0.1, 0.1, 1), "leaf", bent.id));
     change.suns = std::vector<Sun>{SunAt(20, 0, 300)};
@@ -575,7 +575,7 @@ TEST(SceneStore, UndoRestoresTheSceneBefore) {
     ASSERT_EQ(store.Get().nodes.size(), start.nodes.size());
     for (std::size_t i = 0; i < start.nodes.size(); ++i) {
         EXPECT_EQ(store.Get().nodes[i].id, start.nodes[i].id);
-        EXPECT_EQ(store.Get().nodes[i].name, start.nodes[i].name);
+        EXPECT_EQ(store.Get().nodes[i].name(), start.nodes[i].name());
         EXPECT_EQ(store.Get().nodes[i].parentFromLocal(), start.nodes[i].parentFromLocal());
     }
     EXPECT_EQ(store.Get().sources.suns.at(0).towardSun, start.sources.suns.at(0).towardSun);

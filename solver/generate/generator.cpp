@@ -60,7 +60,7 @@ NodeId AppendCopy(Scene& scene, std::size_t begin, std::size_t end, NodeId first
     for (std::size_t i = begin; i < end; ++i) {
         Node node = scene.nodes[i];
         LEAFLUX_CHECK_EQ(node.id, from + (i - begin));
-        const bool generatedName = node.name == GeneratedName(node.type, node.id);
+        const bool generatedName = node.name() == GeneratedName(node.type(), node.id);
         node.id = node.id - from + firstId;
         if (i == begin) {
             node.parent = parent;
@@ -68,7 +68,7 @@ NodeId AppendCopy(Scene& scene, std::size_t begin, std::size_t end, NodeId first
         } else {
             node.parent = node.parent - from + firstId;
         }
-        if (generatedName) node.name = GeneratedName(node.type, node.id);
+        if (generatedName) node.Edit().name = GeneratedName(node.type(), node.id);
         scene.nodes.push_back(std::move(node));
     }
     return firstId + (end - begin);
@@ -120,8 +120,8 @@ class TreeBuilder {
     NodeId Build(const glm::dvec3& base) {
         Node plant;
         plant.id = next_++;
-        plant.type = NodeType::kPlant;
-        plant.name = "plant" + std::to_string(plant.id);
+        plant.Edit().type = NodeType::kPlant;
+        plant.Edit().name = "plant" + std::to_string(plant.id);
         const glm::dmat4 world = FrameOf(base, {1, 0, 0}, {0, 1, 0}, {0, 0, 1});
         plant.Edit().parentFromLocal = world;
         const NodeId plantId = plant.id;
@@ -144,7 +144,8 @@ class TreeBuilder {
         node.id = next_++;
         node.parent = parent;
         node.Edit().parentFromLocal = glm::inverse(worldFromParent) * world;
-        if (node.name.empty()) node.name = NodeTypeName(node.type) + std::to_string(node.id);
+        if (node.name().empty())
+            node.Edit().name = NodeTypeName(node.type()) + std::to_string(node.id);
         scene_.nodes.push_back(std::move(node));
         return scene_.nodes.back().id;
     }
@@ -173,7 +174,7 @@ class TreeBuilder {
         const glm::dvec3 side = AnyPerpendicular(direction);
         const glm::dmat4 world = AxisFrame(worldFromParent, direction);
         Node axis;
-        axis.type = NodeType::kAxis;
+        axis.Edit().type = NodeType::kAxis;
         axis.Edit().age = depth;
         axis.Edit().attributes["order"] = depth;
         const NodeId axisId = Add(std::move(axis), parent, worldFromParent, world);
@@ -193,14 +194,14 @@ class TreeBuilder {
             const glm::dmat4 phytomerWorld =
                 FrameOf(at, side, glm::cross(direction, side), direction);
             Node phytomer;
-            phytomer.type = NodeType::kPhytomer;
+            phytomer.Edit().type = NodeType::kPhytomer;
             phytomer.Edit().age = depth;
             const NodeId phytomerId = Add(std::move(phytomer), axisId, world, phytomerWorld);
             // Twigs of the leafy shoots carry no geometry: thin against the leaves around
             // them, they would multiply the triangles for little light.
             if (p_.internodes && !shoot) {
                 Node internode;
-                internode.type = NodeType::kInternode;
+                internode.Edit().type = NodeType::kInternode;
                 internode.Edit().organ = Organ{internode_, p_.stemOptics};
                 const glm::dvec3 from = base + direction * previous;
                 Add(std::move(internode), phytomerId, phytomerWorld,
@@ -245,7 +246,7 @@ class TreeBuilder {
         const glm::dvec3 normal = glm::cross(blade, width);
         const double length = p_.leafLengthM * (0.8 + 0.4 * random.Uniform());
         Node leaf;
-        leaf.type = NodeType::kLeaf;
+        leaf.Edit().type = NodeType::kLeaf;
         leaf.Edit().organ = Organ{leaf_, p_.leafOptics};
         leaf.Edit().attributes["length_m"] = length;
         Add(std::move(leaf), phytomer, phytomerWorld,
@@ -427,8 +428,8 @@ void AddRandomCanopy(Scene& scene, const CanopyParameters& p) {
             Rotate(AnyPerpendicular(normal), normal, 2.0 * glm::pi<double>() * random.Uniform());
         Node leaf;
         leaf.id = next++;
-        leaf.type = NodeType::kLeaf;
-        leaf.name = "leaf" + std::to_string(i + 1);
+        leaf.Edit().type = NodeType::kLeaf;
+        leaf.Edit().name = "leaf" + std::to_string(i + 1);
         leaf.Edit().organ = Organ{quad, p.leafOptics};
         leaf.Edit().parentFromLocal =
             FrameOf(centre, u * side, glm::cross(normal, u) * side, normal);

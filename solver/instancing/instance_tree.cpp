@@ -169,7 +169,7 @@ std::vector<std::uint32_t> InstanceTree::Opened(
 
 bool InstanceTree::HoldsInstanceOf(const Scene& scene, std::uint32_t q, NodeType type) const {
     for (std::uint32_t inner : parts_[q].instances) {
-        if (scene.nodes[parts_[inner].rootIndex].type == type ||
+        if (scene.nodes[parts_[inner].rootIndex].type() == type ||
             HoldsInstanceOf(scene, inner, type))
             return true;
     }
@@ -178,10 +178,10 @@ bool InstanceTree::HoldsInstanceOf(const Scene& scene, std::uint32_t q, NodeType
 
 bool InstanceTree::HoldsNodeOf(const Scene& scene, std::uint32_t q, NodeType type) const {
     for (std::size_t i : parts_[q].nodes) {
-        if (i != parts_[q].rootIndex && scene.nodes[i].type == type) return true;
+        if (i != parts_[q].rootIndex && scene.nodes[i].type() == type) return true;
     }
     for (std::uint32_t inner : parts_[q].instances) {
-        if (scene.nodes[parts_[inner].rootIndex].type == type || HoldsNodeOf(scene, inner, type))
+        if (scene.nodes[parts_[inner].rootIndex].type() == type || HoldsNodeOf(scene, inner, type))
             return true;
     }
     return false;

@@ -582,7 +582,7 @@ bool InstancedSolve::OpensAsked(std::uint32_t q) const {
     // not instances opens too, so that they are solved.
     const NodeType type = *options_.outputLevel;
     return tree_.HoldsInstanceOf(scene_, q, type) ||
-           (scene_.nodes[tree_[q].rootIndex].type != type && tree_.HoldsNodeOf(scene_, q, type));
+           (scene_.nodes[tree_[q].rootIndex].type() != type && tree_.HoldsNodeOf(scene_, q, type));
 }
 
 std::vector<std::shared_ptr<const RayScene::TriangleRanges>> InstancedSolve::ShadowTriangles()
@@ -664,7 +664,7 @@ void InstancedSolve::SolveWhole(const Level& level, const LevelSolution& light, 
     StructureLight whole;
     whole.node = root.id;
     whole.name = scene_.NodeName(root);
-    whole.type = root.type;
+    whole.type = root.type();
     whole.bands.assign(channels, BandLight{});
     for (BandLight& band : whole.bands)
         band.irradianceUpperWm2 = band.irradianceLowerWm2 = std::nan("");

@@ -15,7 +15,7 @@
 namespace leaflux {
 namespace {
 
-bool IsLeafOrgan(const Node& node) { return node.type == NodeType::kLeaf && node.organ(); }
+bool IsLeafOrgan(const Node& node) { return node.type() == NodeType::kLeaf && node.organ(); }
 
 // Per node, by position in scene.nodes: the leaf organs in its subtree (sums from the last
 // node of a breadth-first order back to the roots), and, when asked, the angle (degrees)
@@ -76,7 +76,7 @@ StructureSignature Classify(const Node& node, std::int64_t leafCount, double inc
                             const std::vector<std::size_t>& attributesByName) {
     StructureSignature s;
     s.id = node.id;
-    s.type = node.type;
+    s.type = node.type();
     s.leafCount = leafCount;
     s.age = node.age();
     s.inclination = inclination;
@@ -86,8 +86,8 @@ StructureSignature Classify(const Node& node, std::int64_t leafCount, double inc
         s.attributes.push_back(
             found == node.attributes().end() ? std::nullopt : std::optional<double>(found->second));
     }
-    const std::string typeName = NodeTypeName(node.type);
-    if (const FixedFunction* cap = policy.FixedFor(node.type);
+    const std::string typeName = NodeTypeName(node.type());
+    if (const FixedFunction* cap = policy.FixedFor(node.type());
         cap && leafCount > cap->leafCountAbove) {
         // Soler 2003 §4.1: functions of large structures converge, one original per type.
         s.fixed = true;
@@ -163,7 +163,7 @@ SceneSignatures ComputeSignatures(const Scene& scene, const InstancingPolicy& po
     std::vector<bool> carried(policy.attributes.size(), false);
     for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
         const Node& node = scene.nodes[i];
-        if (!policy.IsInstanceType(node.type)) continue;
+        if (!policy.IsInstanceType(node.type())) continue;
         for (std::size_t a = 0; a < policy.attributes.size(); ++a) {
             if (node.attributes().count(policy.attributes[a].name)) carried[a] = true;
         }

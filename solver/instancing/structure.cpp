@@ -48,7 +48,7 @@ StructureAlone::StructureAlone(const Scene& scene, NodeId root) {
         throw InputError(ErrorCode::kDegenerate, "root", "has no organ under it", root);
     for (const Receiver& receiver : flat_.receivers) leafAreaM2_ += receiver.areaM2;
     for (const Node& node : alone_.nodes)
-        leafCount_ += node.organ() && node.type == NodeType::kLeaf;
+        leafCount_ += node.organ() && node.type() == NodeType::kLeaf;
     const double pad =
         std::max(kMinPadM, kPadFraction * glm::length(flat_.boundsMax - flat_.boundsMin));
     boxMin_ = flat_.boundsMin - pad;

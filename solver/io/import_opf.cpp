@@ -211,8 +211,8 @@ class OpfReader {
         node.id = static_cast<NodeId>(fileId);
         node.parent = parent;
         const std::string opfClass = element.attribute("class").value();
-        node.type = TypeOfClass(opfClass);
-        node.name = (opfClass.empty() ? "node" : opfClass) + std::to_string(node.id);
+        node.Edit().type = TypeOfClass(opfClass);
+        node.Edit().name = (opfClass.empty() ? "node" : opfClass) + std::to_string(node.id);
         glm::dmat4 worldFromLocal = worldFromParent;
         std::string unusable;  // why the node's geometry carries no light
         pugi::xml_node geometryAt = element;
@@ -236,7 +236,7 @@ class OpfReader {
         if (!unusable.empty() && (node.organ() || !InvertibleFrame(worldFromLocal))) {
             const bool hadOrgan = node.organ().has_value();
             const std::size_t triangles = hadOrgan ? node.organ()->mesh->triangles.size() : 0;
-            unlit_.Skip({At(geometryAt), node.id, node.name,
+            unlit_.Skip({At(geometryAt), node.id, node.name(),
                          unusable + (hadOrgan ? "" : " (no mesh; its children keep their frames)"),
                          triangles});
             node.Edit().organ.reset();

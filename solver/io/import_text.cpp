@@ -126,8 +126,8 @@ class ObjOrgans {
             split_ = false;
             Node node;
             node.id = static_cast<NodeId>(organs_.size() + 1);
-            node.name = Unique(name);
-            node.type = TypeFromName(name);
+            node.Edit().name = Unique(name);
+            node.Edit().type = TypeFromName(name);
             mesh_ = std::make_shared<Mesh>();
             node.Edit().organ = Organ{mesh_, material_};
             organs_.push_back(std::move(node));
@@ -148,7 +148,7 @@ class ObjOrgans {
             polygon_.push_back(local_[index]);
         }
         const Node& organ = organs_[current_];
-        unlit_.AddPolygon(mesh, polygon_, line, organ.name, organ.id);
+        unlit_.AddPolygon(mesh, polygon_, line, organ.name(), organ.id);
     }
     std::vector<Node> Take() { return std::move(organs_); }
 
@@ -269,18 +269,19 @@ ImportedGeometry ReadCan(const std::string& path, const ImportOptions& options) 
                 if (newPlant) {
                     Node plantNode;
                     plantNode.id = plantAt->second = nextId++;
-                    plantNode.type = NodeType::kPlant;
-                    plantNode.name = "plant" + std::to_string(plant);
+                    plantNode.Edit().type = NodeType::kPlant;
+                    plantNode.Edit().name = "plant" + std::to_string(plant);
                     result.nodes.push_back(std::move(plantNode));
                 }
                 Node node;
                 node.id = nextId++;
                 node.parent = plantAt->second;
-                node.type = organ == 0 ? NodeType::kInternode : NodeType::kLeaf;
-                node.name = "plant" + std::to_string(plant) + "_organ" + std::to_string(organ);
+                node.Edit().type = organ == 0 ? NodeType::kInternode : NodeType::kLeaf;
+                node.Edit().name =
+                    "plant" + std::to_string(plant) + "_organ" + std::to_string(organ);
                 const std::string material =
                     "species" + std::to_string(species) + (organ == 0 ? "_stem" : "");
-                found->second = {std::make_shared<Mesh>(), node.id, node.name};
+                found->second = {std::make_shared<Mesh>(), node.id, node.name()};
                 node.Edit().organ = Organ{found->second.mesh, material};
                 result.nodes.push_back(std::move(node));
             }

@@ -97,7 +97,7 @@ void UnlitGeometry::Finish(ImportedGeometry& geometry) {
         if (!node.organ()) continue;
         hadGeometry = true;
         const Mesh& mesh = *node.organ()->mesh;
-        const std::string& name = node.name;  // every importer names its nodes
+        const std::string name = node.name();  // every importer names its nodes
         std::size_t count = 0;
         const std::vector<bool> unlit =
             Unlit(mesh, worldFromLocal.at(node.id), path_, name, node.id, count);

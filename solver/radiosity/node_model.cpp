@@ -136,7 +136,7 @@ void NodeModel::FindOnward(const Scene& scene) {
 // lit as any surface.
 void NodeModel::FindInnerSides(const Scene& scene) {
     std::unordered_map<NodeId, NodeType> types;
-    for (const Node& node : scene.nodes) types[node.id] = node.type;
+    for (const Node& node : scene.nodes) types[node.id] = node.type();
     inner_.assign(flat_.triangles.size(), 0);
     tbb::parallel_for(std::size_t{0}, flat_.receivers.size(), [&](std::size_t r) {
         const Receiver& receiver = flat_.receivers[r];

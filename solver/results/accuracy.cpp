@@ -14,7 +14,7 @@ std::vector<std::size_t> LeafReceivers(const Scene& scene, const FlatScene& flat
                                        const std::unordered_set<NodeId>* within) {
     std::unordered_set<NodeId> leaves;
     for (const Node& node : scene.nodes) {
-        if (node.type == NodeType::kLeaf && (within == nullptr || within->count(node.id)))
+        if (node.type() == NodeType::kLeaf && (within == nullptr || within->count(node.id)))
             leaves.insert(node.id);
     }
     std::vector<std::size_t> receivers;

@@ -79,7 +79,7 @@ std::vector<StructureLight> AggregateStructures(const Scene& scene, const FlatSc
         StructureLight s = std::move(it->second);
         s.node = node.id;
         s.name = scene.NodeName(node);
-        s.type = node.type;
+        s.type = node.type();
         for (BandLight& b : s.bands) {
             b.irradianceUpperWm2 /= s.areaM2;
             b.irradianceLowerWm2 /= s.areaM2;

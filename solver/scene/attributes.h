@@ -1,20 +1,17 @@
 // A node's named numbers (OPF's attributes, a growth model's): a few a node, kept sorted by
 // name in one block, held by pointer so that a node without any pays 8 bytes. A std::map
-// cost 48 bytes a node and about 80 an entry, a std::vector in place 24. The block is shared
-// by copies until one of them changes (copy on write): the nodes of placed structures
-// (leaflux.v1.Scene.placements) share their structure's. Each of the paper's plantation's
-// 1.9 M leaves held a block of its own, about 100 bytes: shared, the scene loaded went
-// from 1,040 to 818 MiB.
+// cost 48 bytes a node and about 80 an entry, a std::vector in place 24. The nodes of placed
+// structures share them with their whole body (NodeBody, copy on write), so that a copy of
+// the attributes is a copy of their entries.
 #pragma once
 
 #include <algorithm>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
-
-#include "solver/util/copy_on_write.h"
 
 namespace leaflux {
 
@@ -24,9 +21,17 @@ class Attributes {
     using const_iterator = std::vector<value_type>::const_iterator;
 
     Attributes() = default;
+    Attributes(const Attributes& other)
+        : entries_(other.entries_ ? std::make_unique<Entries>(*other.entries_) : nullptr) {}
+    Attributes(Attributes&&) noexcept = default;
+    Attributes& operator=(const Attributes& other) {
+        if (this != &other) *this = Attributes(other);
+        return *this;
+    }
+    Attributes& operator=(Attributes&&) noexcept = default;
+    ~Attributes() = default;
 
-    // The value named so, made 0 if absent (as std::map's). The reference is good until the
-    // attributes are next copied (the copy shares what it refers to).
+    // The value named so, made 0 if absent (as std::map's).
     double& operator[](std::string_view name) {
         Entries& entries = Made();
         const auto at = LowerBound(entries.begin(), entries.end(), name);
@@ -62,9 +67,14 @@ class Attributes {
 
   private:
     using Entries = std::vector<value_type>;
-    const Entries& Held() const { return *entries_; }
-    // The entries to change: this node's own, copied from the shared ones.
-    Entries& Made() { return entries_.Edit(); }
+    const Entries& Held() const {
+        static const Entries none;
+        return entries_ ? *entries_ : none;
+    }
+    Entries& Made() {
+        if (!entries_) entries_ = std::make_unique<Entries>();
+        return *entries_;
+    }
     // Where `name` is, or would go.
     template <class Iterator>
     static Iterator LowerBound(Iterator first, Iterator last, std::string_view name) {
@@ -72,7 +82,7 @@ class Attributes {
             first, last, name, [](const value_type& e, std::string_view n) { return e.first < n; });
     }
 
-    CopyOnWrite<Entries> entries_;
+    std::unique_ptr<Entries> entries_;  // null: none
 };
 
 }  // namespace leaflux

@@ -357,8 +357,20 @@ int Scene::OpticsIndex(const std::string& id) const {
     return -1;
 }
 
+std::string WithId(std::string pattern, NodeId id) {
+    const std::string digits = std::to_string(id);
+    for (std::size_t at = pattern.find("{id}"); at != std::string::npos;
+         at = pattern.find("{id}", at + digits.size())) {
+        pattern.replace(at, 4, digits);
+    }
+    return pattern;
+}
+
+std::string Node::name() const { return body_->nameHasId ? WithId(body_->name, id) : body_->name; }
+
 std::string Scene::NodeName(const Node& node) const {
-    return node.name.empty() ? "node" + std::to_string(node.id) : node.name;
+    std::string name = node.name();
+    return name.empty() ? "node" + std::to_string(node.id) : name;
 }
 
 void Scene::Validate() const {

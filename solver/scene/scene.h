@@ -27,7 +27,7 @@ inline constexpr NodeId kNoParent = 0;
 // A session declares at most this many bands: every solve's work and memory grow with them.
 inline constexpr int kMaxBands = 64;
 
-enum class NodeType { kPlant, kAxis, kPhytomer, kLeaf, kInternode, kFruit, kOther };
+enum class NodeType : std::uint8_t { kPlant, kAxis, kPhytomer, kLeaf, kInternode, kFruit, kOther };
 const char* NodeTypeName(NodeType type);
 
 struct Band {
@@ -123,23 +123,29 @@ class Frame {
 // What the nodes of the placed copies of one structure have in common, held once for all of
 // them (Node::Edit).
 struct NodeBody {
+    NodeType type = NodeType::kOther;
+    // "" for "node<id>". With nameHasId (a placed structure's node), a pattern in which
+    // "{id}" stands for the node's id: "leaf{id}" names leaf1042 and its copy leaf2042.
+    std::string name;
+    bool nameHasId = false;
     Frame parentFromLocal;  // z along the structure's main axis
     double age = 0.0;       // physiological age
     Attributes attributes;
     std::optional<Organ> organ;
 };
 
-// A node of the botanical topology: its identity and name, and a body that the copies of
-// a placed structure share (copy on write, solver/util/copy_on_write.h). On the paper's
-// plantation, 233 copies of 4 trees, a node held in full took 176 bytes, 818 MiB for its
-// 4.3 M nodes; a placed copy's node takes 64, and its body is its structure's.
+// A node of the botanical topology: its identity and a body that the copies of a placed
+// structure share (copy on write, solver/util/copy_on_write.h). On the paper's plantation,
+// 233 copies of 4 trees, a node held in full took 176 bytes, 818 MiB for its 4.3 M nodes; a
+// placed copy's node takes 24, and its body is its structure's.
 class Node {
   public:
     NodeId id = 0;
     NodeId parent = kNoParent;
-    NodeType type = NodeType::kOther;
-    std::string name;  // empty: "node<id>"
 
+    NodeType type() const { return body_->type; }
+    // Its name as placed ("{id}" replaced), "" for none (Scene::NodeName says "node<id>").
+    std::string name() const;
     const Frame& parentFromLocal() const { return body_->parentFromLocal; }
     double age() const { return body_->age; }
     const Attributes& attributes() const { return body_->attributes; }
@@ -152,6 +158,9 @@ class Node {
   private:
     CopyOnWrite<NodeBody> body_;
 };
+
+// `pattern` with every "{id}" replaced by `id`.
+std::string WithId(std::string pattern, NodeId id);
 
 // Static environment surface (ground, wall, obstacle), in world coordinates.
 struct Surface {

@@ -102,12 +102,12 @@ NodeId BranchNear(const Scene& scene, int wanted) {
     for (const Node& node : scene.nodes) parent[node.id] = node.parent;
     std::unordered_map<NodeId, int> leaves;
     for (const Node& node : scene.nodes) {
-        if (node.type != NodeType::kLeaf) continue;
+        if (node.type() != NodeType::kLeaf) continue;
         for (NodeId up = node.parent; up != kNoParent; up = parent[up]) ++leaves[up];
     }
     NodeId best = kNoParent;
     for (const Node& node : scene.nodes) {
-        if (node.type != NodeType::kAxis || node.parent == kNoParent) continue;
+        if (node.type() != NodeType::kAxis || node.parent == kNoParent) continue;
         if (best == kNoParent ||
             std::abs(leaves[node.id] - wanted) < std::abs(leaves[best] - wanted))
             best = node.id;
