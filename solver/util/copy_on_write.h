@@ -41,7 +41,7 @@ class CopyOnWrite {
         if (!block_) {
             block_ = new Block;
         } else if (block_->holders.load(std::memory_order_acquire) > 1) {
-            Block* own = new Block{{1}, block_->value};
+            Block* own = new Block{block_->value, {1}};
             Release();
             block_ = own;
         }
@@ -53,8 +53,8 @@ class CopyOnWrite {
 
   private:
     struct Block {
+        [[no_unique_address]] T value{};  // the count may go in its tail padding
         std::atomic<std::uint32_t> holders{1};
-        T value{};
     };
     static const T& Empty() {
         static const T empty{};
