@@ -21,6 +21,7 @@
 #include "solver/radiosity/closed_exchange.h"
 #include "solver/raytrace/occlusion.h"
 #include "solver/scene/geometry.h"
+#include "solver/scene/organ_receivers.h"
 #include "solver/scene/subtrees.h"
 #include "solver/scene/world_frames.h"
 #include "solver/util/box.h"
@@ -71,24 +72,12 @@ class InstancedSolve {
           originals_(originals),
           options_(DirectOnlyAlone(options)),
           out_(out),
-          directions_(DirectionSet::OfLevel(options.hrc.directionLevel)) {
-        organReceiver_.reserve(receivers.receivers.size());
-        for (std::uint32_t r = 0; r < receivers.receivers.size(); ++r) {
-            const Receiver& receiver = receivers.receivers[r];
-            if (receiver.kind == ReceiverKind::kOrgan) {
-                organReceiver_.push_back({receiver.node, r});
-                LEAFLUX_CHECK_EQ(receiver.firstTriangle, organTriangles_);  // organs first
-                organTriangles_ += receiver.triangleCount;
-            } else if (firstOther_ == kNoReceiver) {
-                firstOther_ = r;
-            }
-        }
-        std::sort(organReceiver_.begin(), organReceiver_.end());
+          directions_(DirectionSet::OfLevel(options.hrc.directionLevel)),
+          organs_(receivers),
+          firstOther_(organs_.Count() < receivers.receivers.size() ? organs_.Count()
+                                                                   : kNoReceiver) {
         if (shadows_ != nullptr) shadowTriangles_ = ShadowTriangles();
-        out_.solution.light.assign(receivers.receivers.size(), scene.bands.size());
         out_.solution.balance.assign(scene.bands.size(), EnergyBalance{});
-        out_.solution.unsolved.assign(receivers.receivers.size(), 0);
-        if (options_.pushDown) out_.solution.pushedDown.assign(receivers.receivers.size(), 0);
         out_.stats.depths.assign(tree.Depth() + 1, InstancedStats::Depth{});
         for (const InstanceTree::Part& part : tree.Parts()) {
             ++out_.stats.depths[part.depth].instances;
@@ -100,6 +89,11 @@ class InstancedSolve {
     void Run() {
         if (shadows_ != nullptr) DrawSuns();
         organsProjected_ = OrgansProjectedAreas();
+        // Every organ's light from here on, not beside the walk of OrgansProjectedAreas.
+        const std::size_t all = receivers_.receivers.size();
+        out_.solution.light.assign(all, scene_.bands.size());
+        out_.solution.unsolved.assign(all, 0);
+        if (options_.pushDown) out_.solution.pushedDown.assign(all, 0);
         const std::unique_ptr<Level> top = Build(InstanceTree::kTop, glm::dmat4(1.0), nullptr, 0);
         LevelSolution light = Solve(InstanceTree::kTop, *top, {});
         organsProjected_ = {};
@@ -114,7 +108,7 @@ class InstancedSolve {
     }
 
   private:
-    static constexpr std::uint32_t kNoReceiver = 0xFFFFFFFFu;
+    static constexpr std::uint32_t kNoReceiver = OrganReceivers::kNone;
 
     // Σ A |n · ω| over every organ triangle for each of the top's sources (BeamsOf), in one
     // walk: each triangle's A n held through the top's solve made a plantation's peak.
@@ -160,11 +154,7 @@ class InstancedSolve {
         return firstOther_ + (r - organs);
     }
     // The scene's receiver of an organ; kNoReceiver for a node that is none.
-    std::uint32_t OrganReceiver(NodeId node) const {
-        const auto at = std::lower_bound(organReceiver_.begin(), organReceiver_.end(),
-                                         std::pair<NodeId, std::uint32_t>{node, 0});
-        return at != organReceiver_.end() && at->first == node ? at->second : kNoReceiver;
-    }
+    std::uint32_t OrganReceiver(NodeId node) const { return organs_.Of(node); }
     // The top's receivers are all the scene's; an opened part's are its organs, then the
     // surfaces it holds.
     static std::uint32_t OwnReceivers(std::uint32_t p, const FlatScene& flat) {
@@ -241,9 +231,8 @@ class InstancedSolve {
     const InstancedOptions options_;  // directOnly: holdOutside off (DirectOnlyAlone)
     InstancedSolution& out_;
     const DirectionSet& directions_;
-    std::vector<std::pair<NodeId, std::uint32_t>> organReceiver_;  // sorted by node
+    const OrganReceivers organs_;             // which receiver each organ is
     std::uint32_t firstOther_ = kNoReceiver;  // the first environment surface or emitter
-    std::uint32_t organTriangles_ = 0;        // of the receivers, the organs' first
     // The top's surfaces as solved, each patch side that sends light an emitter, which
     // every opened instance holds (ReceiverKind::kHeld); their meshes shared.
     std::vector<Emitter> held_;
@@ -338,7 +327,7 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
 ShadowView InstancedSolve::ShadowsOf(std::uint32_t p, const FlatScene& flat) const {
     if (shadows_ == nullptr) return {};
     ShadowView view{shadows_, std::vector<std::uint32_t>(flat.triangles.size(), kNoTriangle),
-                    flat.origin - receivers_.origin, organTriangles_, &sunMaps_};
+                    flat.origin - receivers_.origin, organs_.Triangles(), &sunMaps_};
     const std::uint32_t organs = OrganCount(flat);
     for (std::uint32_t r = 0; r < OwnReceivers(p, flat); ++r) {
         const Receiver& local = flat.receivers[r];
@@ -554,7 +543,7 @@ void InstancedSolve::OpenInstances(const Level& level, const LevelSolution& ligh
 
 std::vector<std::uint8_t> InstancedSolve::SolvedTriangles() const {
     if (options_.maxDepth == 0 && !options_.outputLevel && !options_.inView) return {};
-    std::vector<std::uint8_t> solved(organTriangles_, 0);
+    std::vector<std::uint8_t> solved(organs_.Triangles(), 0);
     const auto opens = [&](std::uint32_t q, const glm::dmat4& world) { return Opens(q, world); };
     for (std::uint32_t p : tree_.Opened(opens, options_.inView ? &scene_ : nullptr)) {
         for (std::size_t i : tree_[p].nodes) {

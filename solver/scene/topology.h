@@ -1,8 +1,8 @@
 // A scene's topology by position in Scene::nodes: each node's parent and children and the
-// roots, in flat arrays (12 bytes a node, 16 more while it is made). Hash maps of the
-// nodes by id and a vector of children for each node, as the instanced solver's setup had
-// them, took about 100 bytes a node and left the heap scattered once freed: 14 MiB of a
-// plantation's peak.
+// roots, in flat arrays (12 bytes a node; 16 more while it is made, when the nodes are not
+// in id order). Hash maps of the nodes by id and a vector of children for each node, as the
+// instanced solver's setup had them, took about 100 bytes a node and left the heap
+// scattered once freed: 14 MiB of a plantation's peak.
 #pragma once
 
 #include <cstdint>
