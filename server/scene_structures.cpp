@@ -124,8 +124,8 @@ void Expand(const v1::Scene& message, const MeshLibrary& meshes, std::vector<Nod
         };
         for (std::size_t k = 0; k < s.nodes.size(); ++k) {
             Node node = s.nodes[k];
-            const NodeId local = node.id;
-            node.id = placed(local);
+            const NodeId local = node.id, id = placed(local);
+            node.id = id;
             if (used && !used->insert(node.id).second) {
                 throw InputError(ErrorCode::kAlreadyExists, job.field + ".id_offset",
                                  "places node " + std::to_string(local) + " of structure '" +
@@ -151,7 +151,7 @@ void Expand(const v1::Scene& message, const MeshLibrary& meshes, std::vector<Nod
                 }
             }
             node = made.root;
-            node.id = local + job.offset;
+            node.id = id;
             node.parent = job.rootParent;
             nodes.push_back(std::move(node));
         }
