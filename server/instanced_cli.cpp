@@ -83,7 +83,8 @@ void AddInstancedOptions(CLI::App& solve, InstancedCommand& command) {
 }
 
 Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene* shadows,
-                      const HrcOptions& hrc, const InstancedCommand& command) {
+                      const HrcOptions& hrc, const InstancedCommand& command,
+                      OrganSink* organSink) {
     if (command.pushDown && command.maxDepth == 0 && command.outputLevel.empty()) {
         throw InputError(ErrorCode::kInvalidArgument, "--push-down",
                          "needs --max-depth or --output-level: without them no structure is "
@@ -104,6 +105,7 @@ Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene*
     options.mergeTriangles = command.mergeTriangles;
     options.pushDown = command.pushDown;
     options.inView = command.inView;
+    options.organSink = organSink;
     if (!command.outputLevel.empty()) {
         options.outputLevel = command.outputLevel == "plant"  ? NodeType::kPlant
                               : command.outputLevel == "axis" ? NodeType::kAxis

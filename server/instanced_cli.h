@@ -42,7 +42,9 @@ inline bool CompactShadows(const InstancedCommand& command) {
 
 // Solves with the instanced solver and prints its statistics; `shadows` the flat scene's
 // rays when ShadowsByGeometry, else null and `flat` the receivers alone.
+// `organSink`, when given, gets each organ's light as it is solved (InstancedOptions).
 Solution RunInstanced(const Scene& scene, const FlatScene& flat, const RayScene* shadows,
-                      const HrcOptions& hrc, const InstancedCommand& command);
+                      const HrcOptions& hrc, const InstancedCommand& command,
+                      OrganSink* organSink = nullptr);
 
 }  // namespace leaflux

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -13,6 +14,7 @@
 #include "server/progress.h"
 #include "server/scene_proto.h"
 #include "solver/results/export.h"
+#include "solver/results/leaf_csv_stream.h"
 #include "solver/results/read_leaf_csv.h"
 #include "solver/util/error.h"
 #include "solver/util/memory.h"
@@ -114,7 +116,8 @@ CLI::App* AddSolveCommand(CLI::App& app, SolveCommand& command) {
 }
 
 std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
-                                        const std::function<void(const Scene&)>& check) {
+                                        const std::function<void(const Scene&)>& check,
+                                        std::ostream* leaves) {
     const auto start = std::chrono::steady_clock::now();
     auto solved = std::make_unique<SolvedScene>();
     solved->scene = LoadSceneFile(command.scene, command.file);
@@ -160,9 +163,16 @@ std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
         settings.monteCarlo.progress = ProgressBar("Monte Carlo");
         if (settings.kind == SolverKind::kHrc) settings.hrc.progress = ProgressBar("HRC");
     }
+    std::optional<LeafCsvStream> stream;
+    if (instanced && leaves != nullptr) stream.emplace(*leaves, scene, flat);
     solved->solution = instanced ? RunInstanced(scene, flat, solved->shadows.get(), settings.hrc,
-                                                command.instanced)
+                                                command.instanced, stream ? &*stream : nullptr)
                                  : Solve(*solved->prepared, settings);
+    if (stream) {
+        stream->Finish();
+    } else if (leaves != nullptr) {
+        WriteLeafCsv(*leaves, scene, flat, solved->solution);
+    }
     SolveStats& stats = solved->solution.stats;
     if (peakReset) {
         stats.loadedRssBytes = loaded;
@@ -179,13 +189,31 @@ int RunSolve(const SolveCommand& command) {
     if (!command.ply.empty()) CheckWritable(command.ply, "--ply");
     if (!command.instanced.problems.empty())
         CheckWritable(command.instanced.problems, "--problems");
-    const std::unique_ptr<SolvedScene> solved = SolveScene(command);
+    // The per-organ CSV, written during the solve where nothing after it needs the organs'
+    // light, into a file beside --out renamed to it once whole: a solve that fails leaves
+    // no part of one, and --warm-start may read the --out it replaces. Straight to --out
+    // when that is not a file (a pipe, /dev/stdout).
+    const bool keepLight = !command.structures.empty() || !command.ply.empty();
+    const bool toFile =
+        !std::filesystem::exists(command.out) || std::filesystem::is_regular_file(command.out);
+    const std::string written = toFile ? command.out + ".partial" : command.out;
+    std::ofstream leaves(written);
+    if (!leaves) throw InputError(ErrorCode::kIo, written, "cannot write");
+    std::unique_ptr<SolvedScene> solved;
+    try {
+        solved = SolveScene(command, {}, keepLight ? nullptr : &leaves);
+        if (keepLight) WriteLeafCsv(leaves, solved->scene, solved->Flat(), solved->solution);
+        leaves.close();
+        if (!leaves) throw InputError(ErrorCode::kIo, written, "cannot write");
+    } catch (...) {
+        leaves.close();
+        if (toFile) std::filesystem::remove(written);
+        throw;
+    }
+    if (toFile) std::filesystem::rename(written, command.out);
     const Scene& scene = solved->scene;
     const FlatScene& flat = solved->Flat();
     const Solution& solution = solved->solution;
-    std::ofstream leaves(command.out);
-    if (!leaves) throw InputError(ErrorCode::kIo, command.out, "cannot write");
-    WriteLeafCsv(leaves, scene, flat, solution);
     if (!command.structures.empty()) {
         std::ofstream structures(command.structures);
         if (!structures) throw InputError(ErrorCode::kIo, command.structures, "cannot write");

@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <ostream>
 #include <string>
 
 #include "server/instanced_cli.h"
@@ -48,9 +49,12 @@ struct SolvedScene {
     const FlatScene& Flat() const { return prepared ? prepared->Flat() : receivers; }
 };
 // `check`, when given, sees the scene once loaded, before the solve (what a picture's
-// settings need of it).
+// settings need of it). `leaves`, when given, gets the per-organ CSV: the instanced solver
+// writes it as it reaches the organs (LeafCsvStream), its solution's light table left
+// empty; the other solvers, after the solve.
 std::unique_ptr<SolvedScene> SolveScene(const SolveCommand& command,
-                                        const std::function<void(const Scene&)>& check = {});
+                                        const std::function<void(const Scene&)>& check = {},
+                                        std::ostream* leaves = nullptr);
 
 int RunSolve(const SolveCommand& command);
 

@@ -6,7 +6,8 @@
 # ignores; leaflux-grow's --ply-cycles and stand options; solve's CSV in W and µmol; client
 # cycle --out writes the Python package's CSV, in W and µmol (empty for a band without a
 # photon unit), and prints a summary; the example scripts run as they are and answer --help;
-# solve --ply writes the scene's triangles with every solver; solve --warm-start.
+# solve --ply writes the scene's triangles with every solver; the instanced solver's --out
+# written as it goes; solve --warm-start.
 # Usage: cli_checks.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
 leaflux=$1/server/leaflux
@@ -110,11 +111,22 @@ for shadows in geometry transmittance; do
         fail "instanced --ply ($shadows): $(faces "$out/i.ply") faces, hrc $(faces "$out/h.ply")"
 done
 
-# --warm-start: an earlier --out starts the iteration (every organ found); Monte Carlo, which
-# has no iteration, refuses it naming the option.
+# The instanced solver writes --out as it reaches the organs when nothing after the solve
+# needs their light: the CSV it writes after the solve when --ply does, nothing beside it.
+"$leaflux" solve --scene "$out/t40.scene.txtpb" --quiet --solver instanced --no-phase-db \
+    --shadows transmittance --out "$out/s.csv" > /dev/null
+cmp -s "$out/s.csv" "$out/i.csv" || fail "instanced --out written as it goes differs from after"
+[ -z "$(ls "$out" | grep partial)" ] || fail "a solve left its partial --out"
+
+# --warm-start: an earlier --out starts the iteration (every organ found), the very file the
+# solve then replaces (a growth cycle's); Monte Carlo, which has no iteration, refuses it
+# naming the option.
 "$leaflux" solve --scene "$out/t40.scene.txtpb" --quiet --solver hrc --out "$out/w.csv" \
     --warm-start "$out/h.csv" > "$out/warm.log"
 grep -q "organs warm-started" "$out/warm.log" || fail "--warm-start: no organ started warm"
+"$leaflux" solve --scene "$out/t40.scene.txtpb" --quiet --solver instanced --no-phase-db \
+    --out "$out/w.csv" --warm-start "$out/w.csv" > "$out/warm.log"
+grep -q "organs warm-started" "$out/warm.log" || fail "--warm-start from its own --out: none warm"
 refused "$leaflux" solve --scene "$out/t40.scene.txtpb" --quiet --solver mc --out "$out/m.csv" \
     --warm-start "$out/h.csv"
 grep -q -- "--warm-start" "$out/last.log" || fail "--warm-start with mc: not named"

@@ -2,8 +2,10 @@
 
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <glm/gtc/matrix_transform.hpp>
 #include <map>
@@ -91,7 +93,7 @@ class InstancedSolve {
         organsProjected_ = OrgansProjectedAreas();
         // Every organ's light from here on, not beside the walk of OrgansProjectedAreas.
         const std::size_t all = receivers_.receivers.size();
-        out_.solution.light.assign(all, scene_.bands.size());
+        if (options_.organSink == nullptr) out_.solution.light.assign(all, scene_.bands.size());
         out_.solution.unsolved.assign(all, 0);
         if (options_.pushDown) out_.solution.pushedDown.assign(all, 0);
         const std::unique_ptr<Level> top = Build(InstanceTree::kTop, glm::dmat4(1.0), nullptr, 0);
@@ -157,6 +159,14 @@ class InstancedSolve {
     std::uint32_t OrganReceiver(NodeId node) const { return organs_.Of(node); }
     // The top's receivers are all the scene's; an opened part's are its organs, then the
     // surfaces it holds.
+    // Receiver `global`'s light: to the organ sink, or into the light table.
+    void Emit(std::uint32_t global, std::span<const BandLight> bands) {
+        if (options_.organSink != nullptr) {
+            options_.organSink->Put(global, bands);
+        } else {
+            std::ranges::copy(bands, out_.solution.light[global].begin());
+        }
+    }
     static std::uint32_t OwnReceivers(std::uint32_t p, const FlatScene& flat) {
         return p == InstanceTree::kTop ? static_cast<std::uint32_t>(flat.receivers.size())
                                        : OrganCount(flat);
@@ -365,8 +375,7 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
     const FlatScene& flat = level.flat;
     const std::uint32_t organs = OrganCount(flat);
     for (std::uint32_t r = 0; r < OwnReceivers(p, flat); ++r) {
-        const std::span<const BandLight> bands = light.solution.light[r];
-        std::copy(bands.begin(), bands.end(), out_.solution.light[Global(flat, organs, r)].begin());
+        Emit(Global(flat, organs, r), light.solution.light[r]);
     }
     InstancedStats::Problem size;
     size.depth = tree_[p].depth;
@@ -535,9 +544,16 @@ void InstancedSolve::OpenInstances(const Level& level, const LevelSolution& ligh
     const std::shared_ptr<const HeldOutside> held =
         options_.holdOutside ? HeldBy(level, light) : nullptr;
     const std::size_t inherited = level.closed.size() - level.closedPart.size();
-    // Siblings are independent once their parent is solved: each its own problem.
-    tbb::parallel_for(std::size_t{0}, opened.size(), [&](std::size_t i) {
-        Open(level, opened[i], std::move(arrived[i]), held, inherited + opened[i]);
+    // Siblings are independent once their parent is solved: each its own problem. They
+    // start in their order, each thread taking the next, rather than each thread a share
+    // of them: an organ sink then gets the organs of a few structures out of order at a
+    // time, not of half the scene (LeafCsvStream).
+    std::atomic<std::size_t> next{0};
+    const std::size_t threads =
+        std::min(opened.size(), static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()));
+    tbb::parallel_for(std::size_t{0}, threads, [&](std::size_t) {
+        for (std::size_t i; (i = next++) < opened.size();)
+            Open(level, opened[i], std::move(arrived[i]), held, inherited + opened[i]);
     });
 }
 
@@ -606,6 +622,7 @@ void InstancedSolve::MarkUnsolved(std::uint32_t q, StructureLight& whole) {
         const std::uint32_t global = OrganReceiver(scene_.nodes[i].id);
         if (global == kNoReceiver) continue;
         (options_.pushDown ? out_.solution.pushedDown : out_.solution.unsolved)[global] = 1;
+        if (!options_.pushDown && options_.organSink != nullptr) options_.organSink->Skip(global);
         ++whole.organCount;
         whole.areaM2 += receivers_.receivers[global].areaM2;
     }
@@ -636,8 +653,7 @@ void InstancedSolve::PushDownInto(std::uint32_t q, const ClosedNode& closed,
         PushDown(organs, closed, tau, arrivals, whole.bands, scene_.optics);
     for (std::size_t r = 0; r < organs.receivers.size(); ++r) {
         const std::uint32_t global = OrganReceiver(organs.receivers[r].node);
-        if (global == kNoReceiver) continue;
-        std::copy(light[r].begin(), light[r].end(), out_.solution.light[global].begin());
+        if (global != kNoReceiver) Emit(global, light[r]);
     }
 }
 

@@ -47,6 +47,7 @@
 #include "solver/instancing/policy.h"
 #include "solver/radiosity/hrc.h"
 #include "solver/results/light.h"
+#include "solver/results/organ_sink.h"
 
 namespace leaflux {
 
@@ -93,6 +94,10 @@ struct InstancedOptions {
     // (the command line and the daemon refuse the two together). 0: every instance a problem
     // of its own.
     std::int64_t mergeTriangles = 0;
+    // When set, each organ's light goes here as it is solved, and Solution::light stays
+    // empty: what a plantation's memory would otherwise hold to the end. Its other
+    // receivers' too (the top's surfaces and emitters).
+    OrganSink* organSink = nullptr;
 };
 
 struct InstancedStats {

@@ -58,19 +58,25 @@ constexpr const char* kLightColumns =
 
 }  // namespace
 
+void WriteLeafCsvHeader(std::ostream& out) { out << "organ,band,area_m2," << kLightColumns; }
+
+void WriteLeafRows(std::ostream& out, const Scene& scene, const Receiver& receiver,
+                   std::span<const BandLight> light, std::span<const BandError> error) {
+    const std::string name = CsvQuoted(ReceiverName(scene, receiver));
+    for (std::size_t b = 0; b < scene.bands.size(); ++b) {
+        out << name << ',' << CsvQuoted(scene.bands[b].name) << ',' << Number(receiver.areaM2)
+            << ',';
+        WriteLight(out, light[b], error.empty() ? nullptr : &error[b],
+                   PhotonUmolPerJ(scene.bands[b]));
+    }
+}
+
 void WriteLeafCsv(std::ostream& out, const Scene& scene, const FlatScene& flat,
                   const Solution& solution) {
-    out << "organ,band,area_m2," << kLightColumns;
+    WriteLeafCsvHeader(out);
     for (std::size_t r = 0; r < flat.receivers.size(); ++r) {
         if (!solution.unsolved.empty() && solution.unsolved[r]) continue;
-        const std::string name = ReceiverName(scene, flat.receivers[r]);
-        for (std::size_t b = 0; b < scene.bands.size(); ++b) {
-            out << CsvQuoted(name) << ',' << CsvQuoted(scene.bands[b].name) << ','
-                << Number(flat.receivers[r].areaM2) << ',';
-            const std::span<const BandError> error = solution.ErrorOf(r);
-            WriteLight(out, solution.light[r][b], error.empty() ? nullptr : &error[b],
-                       PhotonUmolPerJ(scene.bands[b]));
-        }
+        WriteLeafRows(out, scene, flat.receivers[r], solution.light[r], solution.ErrorOf(r));
     }
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <ostream>
+#include <span>
 #include <string>
 
 #include "solver/results/light.h"
@@ -23,6 +24,10 @@ std::string CsvQuoted(const std::string& text);
 // µmol s⁻¹, the W columns times the band's PhotonUmolPerJ, empty for a band with none).
 void WriteLeafCsv(std::ostream& out, const Scene& scene, const FlatScene& flat,
                   const Solution& solution);
+// Its parts: the header line, and one receiver's rows (`error` empty: no standard errors).
+void WriteLeafCsvHeader(std::ostream& out);
+void WriteLeafRows(std::ostream& out, const Scene& scene, const Receiver& receiver,
+                   std::span<const BandLight> light, std::span<const BandError> error);
 
 // One row per structure and band: node,name,type,organs,area_m2, then as above.
 void WriteStructureCsv(std::ostream& out, const Scene& scene,
