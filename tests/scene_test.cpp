@@ -95,6 +95,16 @@ std::vector<BadInput> BadInputs() {
          ErrorCode::kNotFound,
          "optics[leaf].bands",
          {}},
+        {"too many optics",
+         [](Scene& s) {
+             for (int i = 0; i < kMaxOptics; ++i) {
+                 s.optics.push_back(s.optics[0]);
+                 s.optics.back().id = "o" + std::to_string(i);
+             }
+         },
+         ErrorCode::kInvalidArgument,
+         "optics",
+         {}},
         {"duplicate optics",
          [](Scene& s) { s.optics.push_back(s.optics[0]); },
          ErrorCode::kAlreadyExists,

@@ -31,7 +31,7 @@ class InstanceTree {
         std::uint32_t parent = kTop;           // the part it is closed in
         int depth = 0;                         // 0: the top, 1: its largest instances, …
         std::string signature;                 // the instance's
-        std::vector<std::size_t> nodes;        // indices into Scene::nodes, in scene order
+        std::vector<std::uint32_t> nodes;      // indices into Scene::nodes, in scene order
         std::vector<std::uint32_t> instances;  // the parts closed in it, in scene order
         // The instance's box in its own frame (its root's local frame) and its organs' area
         // (one side, as an original's), over its whole subtree.

@@ -633,7 +633,7 @@ void InstancedSolve::PushDownInto(std::uint32_t q, const ClosedNode& closed,
                                   std::span<const Arrival> arrivals, const StructureLight& whole) {
     // Its organs in its own frame: its nodes and those of the parts in it, the root at the
     // origin.
-    std::vector<std::size_t> nodes;
+    std::vector<std::uint32_t> nodes;
     std::vector<std::uint32_t> parts{q};
     while (!parts.empty()) {
         const InstanceTree::Part& part = tree_[parts.back()];
@@ -744,7 +744,7 @@ InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& receivers,
     SceneOriginals originals;
     // The signatures are not needed once the functions and the tree are made.
     const InstanceTree tree = [&] {
-        const SceneSignatures signatures = ComputeSignatures(scene, policy);
+        const SceneSignatures signatures = ComputeSignatures(scene, policy, false);
         InstanceTree parts(scene, signatures);
         if (!options.outputLevel) {
             parts.Merge(options.mergeTriangles, [&](std::uint32_t q) {

@@ -38,9 +38,9 @@ StructureAlone::StructureAlone(const Scene& scene, NodeId root) {
         const std::span<const std::uint32_t> children = topology.Children(i);
         stack.insert(stack.end(), children.begin(), children.end());
     }
-    std::vector<std::size_t> indices;
+    std::vector<std::uint32_t> indices;
     for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
-        if (inside[i]) indices.push_back(i);
+        if (inside[i]) indices.push_back(static_cast<std::uint32_t>(i));
     }
     alone_.nodes = Rerooted(scene, indices, root, glm::dmat4(1.0));
     flat_ = Flatten(alone_);

@@ -66,8 +66,9 @@ struct Flattening {
 
 Receiver OrganReceiver(const Scene& scene, std::size_t n) {
     const Node& node = scene.nodes[n];
-    return Receiver{ReceiverKind::kOrgan, static_cast<std::uint32_t>(n), node.id,
-                    scene.OpticsIndex(node.organ()->opticsId)};
+    return Receiver{ReceiverKind::kOrgan,
+                    static_cast<std::int16_t>(scene.OpticsIndex(node.organ()->opticsId)),
+                    static_cast<std::uint32_t>(n), node.id};
 }
 
 // The receivers after the organs, in the flat scene's order — the environment's surfaces,
@@ -78,16 +79,19 @@ void ForEachSurfaceAndEmitter(const Scene& scene, const Visit& visit) {
     for (std::size_t s = 0; s < scene.environment.size(); ++s) {
         const Surface& surface = scene.environment[s];
         visit(PlaceMesh(*surface.mesh, glm::dmat4(1.0)), [&] {
-            return Receiver{ReceiverKind::kEnvironment, static_cast<std::uint32_t>(s), 0,
-                            scene.OpticsIndex(surface.opticsId)};
+            return Receiver{ReceiverKind::kEnvironment,
+                            static_cast<std::int16_t>(scene.OpticsIndex(surface.opticsId)),
+                            static_cast<std::uint32_t>(s), 0};
         });
     }
     for (std::size_t e = 0; e < scene.sources.emitters.size(); ++e) {
         const Emitter& emitter = scene.sources.emitters[e];
         visit(PlaceMesh(*emitter.mesh, glm::dmat4(1.0)), [&] {
             return Receiver{emitter.held ? ReceiverKind::kHeld : ReceiverKind::kEmitter,
-                            static_cast<std::uint32_t>(e), 0,
-                            emitter.opticsId.empty() ? -1 : scene.OpticsIndex(emitter.opticsId)};
+                            static_cast<std::int16_t>(emitter.opticsId.empty()
+                                                          ? -1
+                                                          : scene.OpticsIndex(emitter.opticsId)),
+                            static_cast<std::uint32_t>(e), 0};
         });
     }
 }

@@ -49,6 +49,9 @@ void RequirePerBand(const Scene& scene, const std::vector<double>& values,
 }
 
 void ValidateOptics(const Scene& scene) {
+    Require(scene.optics.size() <= static_cast<std::size_t>(kMaxOptics),
+            ErrorCode::kInvalidArgument, "optics",
+            "at most " + std::to_string(kMaxOptics) + " optics are supported");
     std::set<std::string> ids;
     for (const Optics& optics : scene.optics) {
         const std::string field = "optics[" + optics.id + "]";

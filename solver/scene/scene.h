@@ -27,6 +27,8 @@ using NodeId = std::uint64_t;
 inline constexpr NodeId kNoParent = 0;
 // A session declares at most this many bands: every solve's work and memory grow with them.
 inline constexpr int kMaxBands = 64;
+// And at most this many optics: a receiver holds its optics' index in 2 bytes (Receiver).
+inline constexpr int kMaxOptics = 32767;
 
 enum class NodeType : std::uint8_t { kPlant, kAxis, kPhytomer, kLeaf, kInternode, kFruit, kOther };
 const char* NodeTypeName(NodeType type);

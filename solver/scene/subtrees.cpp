@@ -21,7 +21,7 @@ std::unordered_set<NodeId> NodesUnder(const Scene& scene, const std::vector<Node
     return under;
 }
 
-std::vector<Node> Rerooted(const Scene& scene, std::span<const std::size_t> indices, NodeId root,
+std::vector<Node> Rerooted(const Scene& scene, std::span<const std::uint32_t> indices, NodeId root,
                            const glm::dmat4& rootFrame) {
     std::vector<Node> nodes;
     nodes.reserve(indices.size());

@@ -20,7 +20,7 @@ std::unordered_set<NodeId> NodesUnder(const Scene& scene, const std::vector<Node
 // The nodes of `scene` at `indices` (in scene order, parents first), the one whose id is
 // `root` made a root of its own placed by `rootFrame`: a structure taken out of its scene,
 // in its own frame (identity) or where it lies in the world.
-std::vector<Node> Rerooted(const Scene& scene, std::span<const std::size_t> indices, NodeId root,
+std::vector<Node> Rerooted(const Scene& scene, std::span<const std::uint32_t> indices, NodeId root,
                            const glm::dmat4& rootFrame);
 
 }  // namespace leaflux
