@@ -21,6 +21,7 @@
 #include "server/policy_proto.h"
 #include "solver/generate/generator.h"
 #include "solver/instancing/signature.h"
+#include "solver/scene/topology.h"
 #include "solver/util/error.h"
 #include "tests/scene_builders.h"
 #include "tests/temp_file.h"
@@ -480,6 +481,9 @@ TEST(SignatureOnGeneratedTree, IndependentOfNodeOrder) {
     Scene shuffled = scene;
     std::mt19937_64 random(42);
     std::shuffle(shuffled.nodes.begin(), shuffled.nodes.end(), random);
+    // The one walked without a topology, the other through it.
+    ASSERT_TRUE(InWalkOrder(scene));
+    ASSERT_FALSE(InWalkOrder(shuffled));
     const SceneSignatures reordered = ComputeSignatures(shuffled, policy);
     ASSERT_EQ(reordered.groups.size(), ordered.groups.size());
     for (std::size_t g = 0; g < ordered.groups.size(); ++g) {
@@ -491,6 +495,7 @@ TEST(SignatureOnGeneratedTree, IndependentOfNodeOrder) {
     for (std::size_t i = 0; i < ordered.structures.size(); ++i) {
         EXPECT_EQ(reordered.structures[i].id, ordered.structures[i].id);
         EXPECT_EQ(reordered.structures[i].leafCount, ordered.structures[i].leafCount);
+        EXPECT_EQ(reordered.structures[i].inclination, ordered.structures[i].inclination);
     }
 }
 

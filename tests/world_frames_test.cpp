@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "solver/generate/generator.h"
+#include "solver/scene/topology.h"
 
 namespace leaflux {
 namespace {
@@ -95,6 +96,49 @@ TEST(WorldFrames, AWalkVisitsEachNodeOnceAfterItsParentWithItsFrame) {
     });
     EXPECT_EQ(visited.size(), scene.nodes.size() - 1);
     EXPECT_FALSE(visited.count(90001));
+}
+
+// Nodes already in the walk's order, their ids rising (two generated trees), are walked
+// without a topology, the whole scene and each subtree: the same nodes in the same order
+// with the same frames, to the bit, as the walk over their topology gives.
+TEST(WorldFrames, NodesInWalkOrderAreWalkedAsTheirTopologyWalksThem) {
+    Scene scene;
+    TreeParameters tree;
+    tree.leafCount = 60;
+    NodeId next = AddTree(scene, tree, {1.0, 2.0, 0.0});
+    AddTree(scene, tree, {-3.0, 0.5, 0.0}, next);
+    std::vector<std::pair<const Node*, glm::dmat4>> walked, topological;
+    ForEachWorldFrame(scene, [&](const Node& node, const glm::dmat4& frame) {
+        walked.push_back({&node, frame});
+    });
+    ForEachWorldFrame(scene, Topology(scene), [&](const Node& node, const glm::dmat4& frame) {
+        topological.push_back({&node, frame});
+    });
+    ASSERT_EQ(walked.size(), scene.nodes.size());
+    ASSERT_EQ(walked.size(), topological.size());
+    for (std::size_t k = 0; k < walked.size(); ++k) {
+        ASSERT_EQ(walked[k].first, topological[k].first) << k;
+        EXPECT_EQ(walked[k].first, &scene.nodes[k]);  // in the nodes' order
+        for (int c = 0; c < 4; ++c)
+            EXPECT_EQ(walked[k].second[c], topological[k].second[c]) << walked[k].first->id;
+    }
+    // Every subtree too, in its root's frame.
+    const Topology topology(scene);
+    for (std::size_t root = 0; root < scene.nodes.size(); root += 7) {
+        std::vector<std::pair<const Node*, glm::dmat4>> under, underTopology;
+        ForEachFrameUnder(scene, root, glm::dmat4(1.0), [&](const Node& node, const glm::dmat4& f) {
+            under.push_back({&node, f});
+        });
+        ForEachFrameUnder(scene, topology, root, glm::dmat4(1.0),
+                          [&](const Node& node, const glm::dmat4& f) {
+                              underTopology.push_back({&node, f});
+                          });
+        ASSERT_EQ(under.size(), underTopology.size()) << root;
+        for (std::size_t k = 0; k < under.size(); ++k) {
+            ASSERT_EQ(under[k].first, underTopology[k].first) << root;
+            for (int c = 0; c < 4; ++c) EXPECT_EQ(under[k].second[c], underTopology[k].second[c]);
+        }
+    }
 }
 
 // A subtree walked in its root's own frame, then placed by the root's frame in the world,

@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <unordered_map>
 
@@ -22,38 +23,45 @@ constexpr double kMinPadM = 1e-6;
 }  // namespace
 
 InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures) {
-    const Topology topology(scene);
-    // Each node's part, depth first from the roots; an instance opens a part of its own.
-    // Each node goes straight into its part, which is put in scene order after: the part of
-    // every node first took 4 bytes a node more at the setup's peak.
+    std::optional<Topology> topology;
+    if (!InWalkOrder(scene)) topology.emplace(scene);
+    // Each node's part, depth first from the roots; an instance opens a part of its own,
+    // placed in the world by its root's frame, up its parents (the frames of every node
+    // would be 136 bytes each). Each node goes straight into its part, which is put in
+    // scene order after: the part of every node first took 4 bytes a node more at the
+    // setup's peak.
     parts_.push_back(Part{});
-    std::vector<std::pair<std::size_t, std::uint32_t>> stack;
-    for (auto it = topology.Roots().rbegin(); it != topology.Roots().rend(); ++it)
-        stack.push_back({*it, kTop});
-    while (!stack.empty()) {
-        auto [i, part] = stack.back();
-        stack.pop_back();
-        const Node& node = scene.nodes[i];
-        if (const StructureSignature* s = signatures.Find(node.id); s && !s->signature.empty()) {
-            Part instance;
-            instance.root = node.id;
-            instance.rootIndex = i;
-            instance.parent = part;
-            instance.depth = parts_[part].depth + 1;
-            instance.signature = s->signature;
-            depth_ = std::max(depth_, instance.depth);
-            part = static_cast<std::uint32_t>(parts_.size());
-            parts_[instance.parent].instances.push_back(part);
-            parts_.push_back(std::move(instance));
-        }
-        parts_[part].nodes.push_back(static_cast<std::uint32_t>(i));
-        if (node.organ()) {
-            parts_[part].triangles +=
-                static_cast<std::int64_t>(node.organ()->mesh->triangles.size());
-        }
-        const std::span<const std::uint32_t> children = topology.Children(i);
-        for (auto c = children.rbegin(); c != children.rend(); ++c) stack.push_back({*c, part});
-    }
+    std::vector<glm::dmat4> worldFromRoot{glm::dmat4(1.0)};  // by part
+    std::vector<std::uint32_t> partAbove;                    // of the nodes above, by depth
+    ForEachNodeDown(scene, topology ? &*topology : nullptr,
+                    [&](std::uint32_t i, std::span<const std::uint32_t> above) {
+                        partAbove.resize(above.size());
+                        std::uint32_t part = above.empty() ? kTop : partAbove.back();
+                        const Node& node = scene.nodes[i];
+                        if (const StructureSignature* s = signatures.Find(node.id);
+                            s && !s->signature.empty()) {
+                            Part instance;
+                            instance.root = node.id;
+                            instance.rootIndex = i;
+                            instance.parent = part;
+                            instance.depth = parts_[part].depth + 1;
+                            instance.signature = s->signature;
+                            depth_ = std::max(depth_, instance.depth);
+                            part = static_cast<std::uint32_t>(parts_.size());
+                            parts_[instance.parent].instances.push_back(part);
+                            parts_.push_back(std::move(instance));
+                            glm::dmat4 frame(node.parentFromLocal());
+                            for (auto up = above.rbegin(); up != above.rend(); ++up)
+                                frame = glm::dmat4(scene.nodes[*up].parentFromLocal()) * frame;
+                            worldFromRoot.push_back(frame);
+                        }
+                        partAbove.push_back(part);
+                        parts_[part].nodes.push_back(i);
+                        if (node.organ()) {
+                            parts_[part].triangles +=
+                                static_cast<std::int64_t>(node.organ()->mesh->triangles.size());
+                        }
+                    });
     for (Part& part : parts_) {
         std::sort(part.nodes.begin(), part.nodes.end());
         part.nodes.shrink_to_fit();
@@ -65,19 +73,15 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
     // Boxes, areas and where the areas lie over each instance's whole subtree, in its own
     // frame: the box first, then each triangle's area into its cell (two walks, so that
     // nothing the size of the subtree is kept).
-    // A part root's frame in the world, up its parents (the frames of every node would be
-    // 136 bytes each).
-    const auto worldFromRoot = [&](std::size_t i) {
-        glm::dmat4 frame(scene.nodes[i].parentFromLocal());
-        for (std::uint32_t up = topology.Parent(i); up != Topology::kNone; up = topology.Parent(up))
-            frame = glm::dmat4(scene.nodes[up].parentFromLocal()) * frame;
-        return frame;
-    };
     const auto walkOrgans = [&](const Part& part, const auto& visit) {
-        ForEachFrameUnder(scene, topology, part.rootIndex, glm::dmat4(1.0),
-                          [&](const Node& node, const glm::dmat4& instanceFromNode) {
-                              if (node.organ()) visit(*node.organ()->mesh, instanceFromNode);
-                          });
+        const auto organ = [&](const Node& node, const glm::dmat4& instanceFromNode) {
+            if (node.organ()) visit(*node.organ()->mesh, instanceFromNode);
+        };
+        if (topology) {
+            ForEachFrameUnder(scene, *topology, part.rootIndex, glm::dmat4(1.0), organ);
+        } else {
+            ForEachFrameUnder(scene, part.rootIndex, glm::dmat4(1.0), organ);
+        }
     };
     // Copies of a structure get the same grid, to the bit: held once (a plantation of 233
     // copies of 4 trees held 21 k of them, 18 MB, where 360 differ).
@@ -100,7 +104,7 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
         const double pad = std::max(kMinPadM, kPadFraction * glm::length(hi - lo));
         part.boxMin = lo - pad;
         part.boxMax = hi + pad;
-        const glm::dmat4 worldFromInstance = worldFromRoot(part.rootIndex);
+        const glm::dmat4& worldFromInstance = worldFromRoot[p];
         cells.fill(0.0);
         walkOrgans(part, [&](const Mesh& mesh, const glm::dmat4& instanceFromNode) {
             const glm::dmat4 worldFromNode = worldFromInstance * instanceFromNode;

@@ -129,11 +129,77 @@ struct Counts {
     double pixelM = 0.0;
 };
 
+// Tiles first..last of `drawn` (their triangles' places in a list of all from `start`):
+// each triangle meeting them listed, then each tile drawn and its organs' pixels counted.
+template <class Asked, class EachTile>
+void DrawTiles(const RayScene& scene, const Plane& plane, std::uint32_t triangles,
+               std::uint32_t organs, const Asked& asked, double coplanar,
+               const std::vector<std::int64_t>& drawn, const std::vector<std::uint32_t>& start,
+               std::size_t first, std::size_t last, const EachTile& eachTile,
+               std::vector<std::uint32_t>& listed, Counts& counts) {
+    const std::uint32_t base = start[first];
+    listed.resize(start[last] - base);
+    {
+        std::vector<std::uint32_t> next(start.begin() + first, start.begin() + last);
+        tbb::parallel_for(std::uint32_t{0}, triangles, [&](std::uint32_t t) {
+            eachTile(Draw(scene, plane, t), [&](std::uint32_t k) {
+                if (k < first || k >= last) return;
+                listed[std::atomic_ref<std::uint32_t>(next[k - first])
+                           .fetch_add(1, std::memory_order_relaxed) -
+                       base] = t;
+            });
+        });
+    }
+    tbb::parallel_for(first, last, [&](std::size_t k) {
+        const std::int64_t tx0 = drawn[k] % plane.tilesAcross * kTile;
+        const std::int64_t ty0 = drawn[k] / plane.tilesAcross * kTile;
+        // In triangle order, whatever order the threads listed them in.
+        std::sort(listed.begin() + (start[k] - base), listed.begin() + (start[k + 1] - base));
+        const std::span<const std::uint32_t> list(listed.data() + (start[k] - base),
+                                                  start[k + 1] - start[k]);
+        thread_local std::vector<double> depth;
+        thread_local std::vector<std::uint32_t> covered, lit, tied;
+        depth.assign(kTile * kTile, -std::numeric_limits<double>::infinity());
+        covered.assign(list.size(), 0);
+        lit.assign(list.size(), 0);
+        tied.assign(list.size(), 0);
+        // The depth nearest the light at each pixel, then the organ triangles' pixels that
+        // are within `coplanar` of it: two triangles in one plane do not shade each other,
+        // as a ray from a point of one passes the other.
+        for (std::size_t i = 0; i < list.size(); ++i) {
+            EachSpan(Draw(scene, plane, list[i]), tx0, ty0, kTile,
+                     [&](std::size_t at, std::int64_t n, double z, double dz) {
+                         covered[i] += static_cast<std::uint32_t>(n);
+                         for (std::int64_t c = 0; c < n; ++c, z += dz)
+                             depth[at + c] = std::max(depth[at + c], z);
+                     });
+        }
+        for (std::size_t i = 0; i < list.size() && list[i] < organs; ++i) {
+            if (covered[i] == 0 || !asked(list[i])) continue;
+            EachSpan(Draw(scene, plane, list[i]), tx0, ty0, kTile,
+                     [&](std::size_t at, std::int64_t n, double z, double dz) {
+                         for (std::int64_t c = 0; c < n; ++c, z += dz) {
+                             if (z < depth[at + c] - coplanar) continue;
+                             ++lit[i];
+                             tied[i] += z < depth[at + c] ? 1 : 0;
+                         }
+                     });
+            std::atomic_ref<std::uint32_t>(counts.covered[list[i]])
+                .fetch_add(covered[i], std::memory_order_relaxed);
+            std::atomic_ref<std::uint32_t>(counts.lit[list[i]])
+                .fetch_add(lit[i], std::memory_order_relaxed);
+            if (tied[i] > 0)
+                std::atomic_ref<std::uint8_t>(counts.tied[list[i]])
+                    .store(1, std::memory_order_relaxed);
+        }
+    });
+}
+
 // Draws the scene's triangles across `toward` into `counts`: per organ triangle, the pixels
 // it covers and those where it is the nearest to the light.
 void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t organs,
                std::span<const std::uint8_t> wanted, const glm::dvec3& toward,
-               double pixelsPerTriangle, Counts& counts) {
+               double pixelsPerTriangle, std::uint32_t mostListed, Counts& counts) {
     const auto asked = [&](std::uint32_t t) { return t < organs && (wanted.empty() || wanted[t]); };
     Plane plane(toward);
     // The organs' extent and mean area across the light, which size the pixel.
@@ -219,59 +285,13 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
         });
     });
     for (std::size_t k = 0; k < drawn.size(); ++k) start[k + 1] += start[k];
-    std::vector<std::uint32_t> listed(start.back());
-    {
-        std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
-        tbb::parallel_for(std::uint32_t{0}, triangles, [&](std::uint32_t t) {
-            eachTile(Draw(scene, plane, t), [&](std::uint32_t k) {
-                listed[std::atomic_ref<std::uint32_t>(next[k]).fetch_add(
-                    1, std::memory_order_relaxed)] = t;
-            });
-        });
+    std::vector<std::uint32_t> listed;
+    for (std::size_t first = 0, last; first < drawn.size(); first = last) {
+        last = first + 1;
+        while (last < drawn.size() && start[last + 1] - start[first] <= mostListed) ++last;
+        DrawTiles(scene, plane, triangles, organs, asked, coplanar, drawn, start, first, last,
+                  eachTile, listed, counts);
     }
-    tbb::parallel_for(std::size_t{0}, drawn.size(), [&](std::size_t k) {
-        const std::int64_t tx0 = drawn[k] % plane.tilesAcross * kTile;
-        const std::int64_t ty0 = drawn[k] / plane.tilesAcross * kTile;
-        // In triangle order, whatever order the threads listed them in.
-        std::sort(listed.begin() + start[k], listed.begin() + start[k + 1]);
-        const std::span<const std::uint32_t> list(listed.data() + start[k],
-                                                  start[k + 1] - start[k]);
-        thread_local std::vector<double> depth;
-        thread_local std::vector<std::uint32_t> covered, lit, tied;
-        depth.assign(kTile * kTile, -std::numeric_limits<double>::infinity());
-        covered.assign(list.size(), 0);
-        lit.assign(list.size(), 0);
-        tied.assign(list.size(), 0);
-        // The depth nearest the light at each pixel, then the organ triangles' pixels that
-        // are within `coplanar` of it: two triangles in one plane do not shade each other,
-        // as a ray from a point of one passes the other.
-        for (std::size_t i = 0; i < list.size(); ++i) {
-            EachSpan(Draw(scene, plane, list[i]), tx0, ty0, kTile,
-                     [&](std::size_t at, std::int64_t n, double z, double dz) {
-                         covered[i] += static_cast<std::uint32_t>(n);
-                         for (std::int64_t c = 0; c < n; ++c, z += dz)
-                             depth[at + c] = std::max(depth[at + c], z);
-                     });
-        }
-        for (std::size_t i = 0; i < list.size() && list[i] < organs; ++i) {
-            if (covered[i] == 0 || !asked(list[i])) continue;
-            EachSpan(Draw(scene, plane, list[i]), tx0, ty0, kTile,
-                     [&](std::size_t at, std::int64_t n, double z, double dz) {
-                         for (std::int64_t c = 0; c < n; ++c, z += dz) {
-                             if (z < depth[at + c] - coplanar) continue;
-                             ++lit[i];
-                             tied[i] += z < depth[at + c] ? 1 : 0;
-                         }
-                     });
-            std::atomic_ref<std::uint32_t>(counts.covered[list[i]])
-                .fetch_add(covered[i], std::memory_order_relaxed);
-            std::atomic_ref<std::uint32_t>(counts.lit[list[i]])
-                .fetch_add(lit[i], std::memory_order_relaxed);
-            if (tied[i] > 0)
-                std::atomic_ref<std::uint8_t>(counts.tied[list[i]])
-                    .store(1, std::memory_order_relaxed);
-        }
-    });
 }
 
 }  // namespace
@@ -294,8 +314,8 @@ SunMaps::SunMaps(const RayScene& rays, const FlatScene& receivers, const std::ve
 
 SunMap::SunMap(const RayScene& scene, std::uint32_t triangles, std::uint32_t organTriangles,
                const glm::dvec3& toward, double cosRadius, double pixelsPerTriangle,
-               std::span<const std::uint8_t> wanted)
-    : toward_(toward), cosRadius_(cosRadius), lit_(organTriangles, kNone) {
+               std::span<const std::uint8_t> wanted, std::uint32_t mostListed)
+    : toward_(toward), cosRadius_(cosRadius) {
     LEAFLUX_CHECK(!scene.Periodic());
     LEAFLUX_CHECK(organTriangles <= triangles);
     LEAFLUX_CHECK(wanted.empty() || wanted.size() == organTriangles);
@@ -303,7 +323,8 @@ SunMap::SunMap(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
                   std::vector<std::uint32_t>(organTriangles, 0),
                   std::vector<std::uint8_t>(organTriangles, 0)};
     if (cosRadius >= 1.0) {
-        DrawAlong(scene, triangles, organTriangles, wanted, toward, pixelsPerTriangle, counts);
+        DrawAlong(scene, triangles, organTriangles, wanted, toward, pixelsPerTriangle, mostListed,
+                  counts);
     } else {
         // Directions even in solid angle over the disc, turning by the golden angle.
         const Plane around(toward);
@@ -315,9 +336,12 @@ SunMap::SunMap(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
             const glm::dvec3 w = cosTheta * toward +
                                  sinTheta * (std::cos(phi) * around.u + std::sin(phi) * around.v);
             DrawAlong(scene, triangles, organTriangles, wanted, glm::normalize(w),
-                      pixelsPerTriangle, counts);
+                      pixelsPerTriangle, mostListed, counts);
         }
     }
+    // Once drawn: beside the counts and the tiles' lists it took 10 MB more at a plantation's
+    // peak.
+    lit_.assign(organTriangles, kNone);
     for (std::uint32_t t = 0; t < organTriangles; ++t) {
         if (counts.covered[t] == 0) continue;
         lit_[t] = static_cast<std::uint16_t>(

@@ -26,6 +26,9 @@ class SunMap {
     static constexpr double kPixelsPerTriangle = 256.0;
     static constexpr double kLeastPixels = 1 << 20;  // over all the organs, however few
     static constexpr int kDiscDirections = 8;
+    // The tiles are drawn in runs of at most this many (triangle, tile) pairs, at least one
+    // tile a run: listed all at once, a plantation of 5 M triangles took 35 MB at its peak.
+    static constexpr std::uint32_t kMostListed = 1u << 21;
 
     // Over the scene's first `triangles` triangles (not periodic), of which the first
     // `organTriangles` are lit; `toward`: unit, towards the sun; `cosRadius`: of its angular
@@ -34,8 +37,8 @@ class SunMap {
     // are drawn, on the pixels of the map of all: a wanted triangle's share is the same.
     SunMap(const RayScene& scene, std::uint32_t triangles, std::uint32_t organTriangles,
            const glm::dvec3& toward, double cosRadius,
-           double pixelsPerTriangle = kPixelsPerTriangle,
-           std::span<const std::uint8_t> wanted = {});
+           double pixelsPerTriangle = kPixelsPerTriangle, std::span<const std::uint8_t> wanted = {},
+           std::uint32_t mostListed = kMostListed);
 
     const glm::dvec3& Toward() const { return toward_; }
     double CosRadius() const { return cosRadius_; }

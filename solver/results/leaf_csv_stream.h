@@ -9,6 +9,7 @@
 #include <map>
 #include <mutex>
 #include <ostream>
+#include <string>
 #include <vector>
 
 #include "solver/results/organ_sink.h"
@@ -32,16 +33,16 @@ class LeafCsvStream final : public OrganSink {
     std::size_t MostWaiting() const { return mostWaiting_; }
 
   private:
-    // Receiver `receiver`'s rows (none if skipped: no bands), or it waits; then those waiting
-    // behind it. Under mutex_.
-    void Arrive(std::size_t receiver, std::span<const BandLight> bands);
+    // Receiver `receiver`'s rows (none if skipped), or they wait; then those waiting behind
+    // it. Under mutex_.
+    void Arrive(std::size_t receiver, std::string rows);
 
     std::ostream& out_;
     const Scene& scene_;
     const FlatScene& flat_;
     std::mutex mutex_;
-    std::size_t next_ = 0;                                   // the first receiver not yet written
-    std::map<std::size_t, std::vector<BandLight>> waiting_;  // skipped: no bands
+    std::size_t next_ = 0;                        // the first receiver not yet written
+    std::map<std::size_t, std::string> waiting_;  // their rows; skipped: none
     std::size_t mostWaiting_ = 0;
 };
 

@@ -55,4 +55,20 @@ Topology::Topology(const Scene& scene) {
     first_[0] = 0;
 }
 
+bool InWalkOrder(const Scene& scene) {
+    std::vector<NodeId> down;  // the ids on the way down to the node before
+    for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
+        const Node& node = scene.nodes[i];
+        if (i > 0 && node.id <= scene.nodes[i - 1].id) return false;
+        if (node.parent == kNoParent) {
+            down.clear();
+        } else {
+            while (!down.empty() && down.back() != node.parent) down.pop_back();
+            if (down.empty()) return false;
+        }
+        down.push_back(node.id);
+    }
+    return true;
+}
+
 }  // namespace leaflux

@@ -34,8 +34,9 @@ class WorldFrames {
 
 // Each node with its frame in the world, parents before children (depth first from the
 // roots, each node's children in the nodes' order), the frames not kept: about 30 bytes a
-// node for the walk (Topology), where WorldFrames keeps 136. Nodes whose parent links loop
-// or lead to no node are not visited.
+// node for the walk (Topology), where WorldFrames keeps 136, and none when the nodes are in
+// that order already, their ids rising (as a generated or placed scene has them). Nodes
+// whose parent links loop or lead to no node are not visited.
 void ForEachWorldFrame(const Scene& scene,
                        const std::function<void(const Node&, const glm::dmat4&)>& visit);
 // The same over the scene's topology, when the caller has it.
@@ -47,6 +48,10 @@ void ForEachWorldFrame(const Scene& scene, const Topology& topology,
 // in the root's own frame (an instance's).
 void ForEachFrameUnder(const Scene& scene, const Topology& topology, std::size_t root,
                        const glm::dmat4& rootFrame,
+                       const std::function<void(const Node&, const glm::dmat4&)>& visit);
+// The same for a scene InWalkOrder, without its topology: the subtree is the nodes from
+// `root` on while they lie under it.
+void ForEachFrameUnder(const Scene& scene, std::size_t root, const glm::dmat4& rootFrame,
                        const std::function<void(const Node&, const glm::dmat4&)>& visit);
 
 // worldFromLocal of every node, by id. Requires a validated scene (no cycles).
