@@ -229,11 +229,12 @@ def largest_scenes(rows):
             line += " In all, reading the scene included: " + "; ".join(
                 f"{r['solver']} {number(whole[r['solver']])} s (the scene once read: "
                 f"{number(r['loaded_mib'])} MiB)" for r in at if r["solver"] in whole) + "."
-            met = [r["solver"] for r in at
-                   if whole.get(r["solver"], math.inf) <= 120 and float(r["peak_mib"]) <= goal_mib]
+            fast = {r["solver"] for r in at if whole.get(r["solver"], math.inf) <= 120}
+            lean = {r["solver"] for r in at if r["solver"] in whole and float(r["peak_mib"]) <= goal_mib}
+            by = lambda solvers: ", ".join(r["solver"] for r in at if r["solver"] in solvers) or "none"
             line += (f" The paper's goal for its plantation (233 trees, about 5 M polygons), ≤ 2 "
-                     f"minutes and ≤ 300 MB ({goal_mib:.0f} MiB) in all: met by "
-                     f"{', '.join(met) if met else 'none'}.")
+                     f"minutes and ≤ 300 MB ({goal_mib:.0f} MiB) in all: met by {by(fast & lean)}; "
+                     f"the time by {by(fast)}, the memory by {by(lean)}.")
         text.append(line)
     return "\n\n".join(text)
 

@@ -94,7 +94,9 @@ CLI::App* AddSolveCommand(CLI::App& app, SolveCommand& command) {
                     "radiosity), and check that the links cover every exchange once");
     solve
         ->add_option("--out", command.out,
-                     "Per-organ CSV (its folder is made): organ,band,area_m2,"
+                     "Per-organ CSV (its folder is made; written to OUT.partial, renamed once "
+                     "whole; the instanced solver writes each organ as it solves it): "
+                     "organ,band,area_m2,"
                      "irradiance_upper_wm2,irradiance_lower_wm2,absorbed_w,light_x,light_y,"
                      "light_z,stderr_upper_wm2,stderr_lower_wm2, then PAR in photons: "
                      "photon_irradiance_upper_umol_m2_s,photon_irradiance_lower_umol_m2_s,"

@@ -157,16 +157,13 @@ class InstancedSolve {
     }
     // The scene's receiver of an organ; kNoReceiver for a node that is none.
     std::uint32_t OrganReceiver(NodeId node) const { return organs_.Of(node); }
-    // The top's receivers are all the scene's; an opened part's are its organs, then the
-    // surfaces it holds.
     // Receiver `global`'s light: to the organ sink, or into the light table.
     void Emit(std::uint32_t global, std::span<const BandLight> bands) {
-        if (options_.organSink != nullptr) {
-            options_.organSink->Put(global, bands);
-        } else {
-            std::ranges::copy(bands, out_.solution.light[global].begin());
-        }
+        if (options_.organSink != nullptr) return options_.organSink->Put(global, bands);
+        std::ranges::copy(bands, out_.solution.light[global].begin());
     }
+    // The top's receivers are all the scene's; an opened part's are its organs, then the
+    // surfaces it holds.
     static std::uint32_t OwnReceivers(std::uint32_t p, const FlatScene& flat) {
         return p == InstanceTree::kTop ? static_cast<std::uint32_t>(flat.receivers.size())
                                        : OrganCount(flat);
@@ -544,10 +541,9 @@ void InstancedSolve::OpenInstances(const Level& level, const LevelSolution& ligh
     const std::shared_ptr<const HeldOutside> held =
         options_.holdOutside ? HeldBy(level, light) : nullptr;
     const std::size_t inherited = level.closed.size() - level.closedPart.size();
-    // Siblings are independent once their parent is solved: each its own problem. They
-    // start in their order, each thread taking the next, rather than each thread a share
-    // of them: an organ sink then gets the organs of a few structures out of order at a
-    // time, not of half the scene (LeafCsvStream).
+    // Siblings are independent once their parent is solved: each its own problem, started
+    // in their order, each thread taking the next, so that an organ sink gets few organs
+    // out of order (LeafCsvStream), not half the scene's as a share a thread took.
     std::atomic<std::size_t> next{0};
     const std::size_t threads =
         std::min(opened.size(), static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()));
@@ -744,7 +740,7 @@ InstancedSolution SolveInstanced(const Scene& scene, const FlatScene& receivers,
     SceneOriginals originals;
     // The signatures are not needed once the functions and the tree are made.
     const InstanceTree tree = [&] {
-        const SceneSignatures signatures = ComputeSignatures(scene, policy, false);
+        const SceneSignatures signatures = ComputeSignatures(scene, policy, /*unbinned=*/false);
         InstanceTree parts(scene, signatures);
         if (!options.outputLevel) {
             parts.Merge(options.mergeTriangles, [&](std::uint32_t q) {
