@@ -15,9 +15,8 @@
 namespace leaflux {
 namespace {
 
-constexpr int kTile = 128;                      // pixels a side of a tile
-constexpr std::int64_t kMostTiles = 1 << 22;    // of the plane over the organs
-constexpr std::uint32_t kNoTile = 0xFFFFFFFFu;  // a tile no organ lies in
+constexpr int kTile = 128;                    // pixels a side of a tile
+constexpr std::int64_t kMostTiles = 1 << 22;  // of the plane over the organs
 
 // The plane across a direction of light: pixel (i, j) has its centre at
 // origin + size (i + ½, j + ½) along u and v; depth grows towards the light.
@@ -262,21 +261,29 @@ void DrawAlong(const RayScene& scene, std::uint32_t triangles, std::uint32_t org
                     .store(1, std::memory_order_relaxed);
         }
     });
-    std::vector<std::uint32_t> number(tiles, kNoTile);
-    std::vector<std::int64_t> drawn;  // the tiles drawn, by number
+    // The tiles drawn, rising, and where each row of tiles starts among them: a number for
+    // every tile of the plane took 4 bytes a tile, 16 MB at a plantation's peak.
+    std::vector<std::int64_t> drawn;
+    std::vector<std::uint32_t> rowStart(plane.tilesDown + 1, 0);
     for (std::int64_t k = 0; k < tiles; ++k) {
-        if (organTile[k]) number[k] = static_cast<std::uint32_t>(drawn.size()), drawn.push_back(k);
+        if (!organTile[k]) continue;
+        drawn.push_back(k);
+        ++rowStart[k / plane.tilesAcross + 1];
     }
     organTile = {};
-    // Every triangle into the drawn tiles its box meets: counted, then listed.
+    for (std::int64_t row = 0; row < plane.tilesDown; ++row) rowStart[row + 1] += rowStart[row];
+    // Every triangle into the drawn tiles its box meets (their numbers, rising): counted,
+    // then listed.
     std::vector<std::uint32_t> start(drawn.size() + 1, 0);
     const auto eachTile = [&](const Drawn& d, auto&& visit) {
         if (d.x0 > d.x1 || d.y0 > d.y1) return;
         for (std::int64_t ty = d.y0 / kTile; ty <= d.y1 / kTile; ++ty) {
-            for (std::int64_t tx = d.x0 / kTile; tx <= d.x1 / kTile; ++tx) {
-                if (const std::uint32_t k = number[ty * plane.tilesAcross + tx]; k != kNoTile)
-                    visit(k);
-            }
+            const auto rowEnd = drawn.begin() + rowStart[ty + 1];
+            const std::int64_t last = ty * plane.tilesAcross + d.x1 / kTile;
+            for (auto k = std::lower_bound(drawn.begin() + rowStart[ty], rowEnd,
+                                           ty * plane.tilesAcross + d.x0 / kTile);
+                 k != rowEnd && *k <= last; ++k)
+                visit(static_cast<std::uint32_t>(k - drawn.begin()));
         }
     };
     tbb::parallel_for(std::uint32_t{0}, triangles, [&](std::uint32_t t) {

@@ -157,16 +157,22 @@ FlatScene Flatten(const Scene& scene) {
 FlatScene ReceiversOf(const Scene& scene) {
     Flattening out;
     out.keep = false;
-    std::vector<double> areas(scene.nodes.size(), 0.0);
-    ForEachPlacedOrgan(scene, [&](std::size_t n, const std::vector<Triangle>& placed) {
-        areas[n] = out.Bound(placed);
-    });
+    // The organs' receivers in the nodes' order, as many as there will be, then their areas
+    // as the walk places them, each found by its node: an area per node and the receivers
+    // grown by doubling took 36 and 33 MB more on the paper's plantation.
+    std::size_t organs = 0;
+    for (const Node& node : scene.nodes) organs += node.organ() ? 1 : 0;
+    out.flat.receivers.reserve(organs + scene.environment.size() + scene.sources.emitters.size());
     for (std::size_t n = 0; n < scene.nodes.size(); ++n) {
-        if (!scene.nodes[n].organ()) continue;
-        Receiver receiver = OrganReceiver(scene, n);
-        receiver.areaM2 = areas[n];
-        out.Append(receiver, scene.nodes[n].organ()->mesh->triangles.size());
+        if (scene.nodes[n].organ())
+            out.Append(OrganReceiver(scene, n), scene.nodes[n].organ()->mesh->triangles.size());
     }
+    ForEachPlacedOrgan(scene, [&](std::size_t n, const std::vector<Triangle>& placed) {
+        const auto receiver =
+            std::lower_bound(out.flat.receivers.begin(), out.flat.receivers.end(), n,
+                             [](const Receiver& r, std::size_t node) { return r.declared < node; });
+        receiver->areaM2 = out.Bound(placed);
+    });
     ForEachSurfaceAndEmitter(scene, [&](const std::vector<Triangle>& triangles,
                                         const auto& receiver) { out.Add(triangles, receiver()); });
     return out.Finish();
