@@ -126,9 +126,10 @@ TEST(WorldFrames, NodesInWalkOrderAreWalkedAsTheirTopologyWalksThem) {
     const Topology topology(scene);
     for (std::size_t root = 0; root < scene.nodes.size(); root += 7) {
         std::vector<std::pair<const Node*, glm::dmat4>> under, underTopology;
-        ForEachFrameUnder(scene, root, glm::dmat4(1.0), [&](const Node& node, const glm::dmat4& f) {
-            under.push_back({&node, f});
-        });
+        ForEachFrameUnder(scene, nullptr, root, glm::dmat4(1.0),
+                          [&](const Node& node, const glm::dmat4& f) {
+                              under.push_back({&node, f});
+                          });
         ForEachFrameUnder(scene, topology, root, glm::dmat4(1.0),
                           [&](const Node& node, const glm::dmat4& f) {
                               underTopology.push_back({&node, f});

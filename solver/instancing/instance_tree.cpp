@@ -23,8 +23,8 @@ constexpr double kMinPadM = 1e-6;
 }  // namespace
 
 InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures) {
-    std::optional<Topology> topology;
-    if (!InWalkOrder(scene)) topology.emplace(scene);
+    const std::optional<Topology> topology = TopologyUnlessInWalkOrder(scene);
+    const Topology* walk = topology ? &*topology : nullptr;
     // Each node's part, depth first from the roots; an instance opens a part of its own,
     // placed in the world by its root's frame, up its parents (the frames of every node
     // would be 136 bytes each). Each node goes straight into its part, which is put in
@@ -33,35 +33,33 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
     parts_.push_back(Part{});
     std::vector<glm::dmat4> worldFromRoot{glm::dmat4(1.0)};  // by part
     std::vector<std::uint32_t> partAbove;                    // of the nodes above, by depth
-    ForEachNodeDown(scene, topology ? &*topology : nullptr,
-                    [&](std::uint32_t i, std::span<const std::uint32_t> above) {
-                        partAbove.resize(above.size());
-                        std::uint32_t part = above.empty() ? kTop : partAbove.back();
-                        const Node& node = scene.nodes[i];
-                        if (const StructureSignature* s = signatures.Find(node.id);
-                            s && !s->signature.empty()) {
-                            Part instance;
-                            instance.root = node.id;
-                            instance.rootIndex = i;
-                            instance.parent = part;
-                            instance.depth = parts_[part].depth + 1;
-                            instance.signature = s->signature;
-                            depth_ = std::max(depth_, instance.depth);
-                            part = static_cast<std::uint32_t>(parts_.size());
-                            parts_[instance.parent].instances.push_back(part);
-                            parts_.push_back(std::move(instance));
-                            glm::dmat4 frame(node.parentFromLocal());
-                            for (auto up = above.rbegin(); up != above.rend(); ++up)
-                                frame = glm::dmat4(scene.nodes[*up].parentFromLocal()) * frame;
-                            worldFromRoot.push_back(frame);
-                        }
-                        partAbove.push_back(part);
-                        parts_[part].nodes.push_back(i);
-                        if (node.organ()) {
-                            parts_[part].triangles +=
-                                static_cast<std::int64_t>(node.organ()->mesh->triangles.size());
-                        }
-                    });
+    ForEachNodeDown(scene, walk, [&](std::uint32_t i, std::span<const std::uint32_t> above) {
+        partAbove.resize(above.size());
+        std::uint32_t part = above.empty() ? kTop : partAbove.back();
+        const Node& node = scene.nodes[i];
+        if (const StructureSignature* s = signatures.Find(node.id); s && !s->signature.empty()) {
+            Part instance;
+            instance.root = node.id;
+            instance.rootIndex = i;
+            instance.parent = part;
+            instance.depth = parts_[part].depth + 1;
+            instance.signature = s->signature;
+            depth_ = std::max(depth_, instance.depth);
+            part = static_cast<std::uint32_t>(parts_.size());
+            parts_[instance.parent].instances.push_back(part);
+            parts_.push_back(std::move(instance));
+            glm::dmat4 frame(node.parentFromLocal());
+            for (auto up = above.rbegin(); up != above.rend(); ++up)
+                frame = glm::dmat4(scene.nodes[*up].parentFromLocal()) * frame;
+            worldFromRoot.push_back(frame);
+        }
+        partAbove.push_back(part);
+        parts_[part].nodes.push_back(i);
+        if (node.organ()) {
+            parts_[part].triangles +=
+                static_cast<std::int64_t>(node.organ()->mesh->triangles.size());
+        }
+    });
     for (Part& part : parts_) {
         std::sort(part.nodes.begin(), part.nodes.end());
         part.nodes.shrink_to_fit();
@@ -74,14 +72,10 @@ InstanceTree::InstanceTree(const Scene& scene, const SceneSignatures& signatures
     // frame: the box first, then each triangle's area into its cell (two walks, so that
     // nothing the size of the subtree is kept).
     const auto walkOrgans = [&](const Part& part, const auto& visit) {
-        const auto organ = [&](const Node& node, const glm::dmat4& instanceFromNode) {
-            if (node.organ()) visit(*node.organ()->mesh, instanceFromNode);
-        };
-        if (topology) {
-            ForEachFrameUnder(scene, *topology, part.rootIndex, glm::dmat4(1.0), organ);
-        } else {
-            ForEachFrameUnder(scene, part.rootIndex, glm::dmat4(1.0), organ);
-        }
+        ForEachFrameUnder(scene, walk, part.rootIndex, glm::dmat4(1.0),
+                          [&](const Node& node, const glm::dmat4& instanceFromNode) {
+                              if (node.organ()) visit(*node.organ()->mesh, instanceFromNode);
+                          });
     };
     // Copies of a structure get the same grid, to the bit: held once (a plantation of 233
     // copies of 4 trees held 21 k of them, 18 MB, where 360 differ).

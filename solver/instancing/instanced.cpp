@@ -166,20 +166,7 @@ class InstancedSolve {
     // surfaces it holds.
     static std::uint32_t OwnReceivers(std::uint32_t p, const FlatScene& flat) {
         return p == InstanceTree::kTop ? static_cast<std::uint32_t>(flat.receivers.size())
-                                       : OrganCount(flat);
-    }
-    static std::uint32_t OrganTriangles(const FlatScene& flat) {
-        const std::uint32_t organs = OrganCount(flat);
-        if (organs == flat.receivers.size())
-            return static_cast<std::uint32_t>(flat.triangles.size());
-        return flat.receivers[organs].firstTriangle;
-    }
-    static std::uint32_t OrganCount(const FlatScene& flat) {
-        std::uint32_t organs = 0;
-        while (organs < flat.receivers.size() &&
-               flat.receivers[organs].kind == ReceiverKind::kOrgan)
-            ++organs;
-        return organs;
+                                       : LeadingOrgans(flat);
     }
     ShadowView ShadowsOf(std::uint32_t p, const FlatScene& flat) const;
     // A map of each sun over the whole scene's triangles (SunMap): the light of the suns on
@@ -322,7 +309,7 @@ std::unique_ptr<Level> InstancedSolve::Build(std::uint32_t p, const glm::dmat4& 
     // links alone.
     level->rays = std::make_unique<RayScene>(
         level->flat, std::nullopt, RayDevice::Shared(),
-        p == InstanceTree::kTop ? kNoTriangle : OrganTriangles(level->flat));
+        p == InstanceTree::kTop ? kNoTriangle : LeadingOrganTriangles(level->flat));
     OutsideView view;
     if (outside != nullptr) {
         view = {
@@ -337,7 +324,7 @@ ShadowView InstancedSolve::ShadowsOf(std::uint32_t p, const FlatScene& flat) con
     if (shadows_ == nullptr) return {};
     ShadowView view{shadows_, std::vector<std::uint32_t>(flat.triangles.size(), kNoTriangle),
                     flat.origin - receivers_.origin, organs_.Triangles(), &sunMaps_};
-    const std::uint32_t organs = OrganCount(flat);
+    const std::uint32_t organs = LeadingOrgans(flat);
     for (std::uint32_t r = 0; r < OwnReceivers(p, flat); ++r) {
         const Receiver& local = flat.receivers[r];
         const Receiver& whole = receivers_.receivers[Global(flat, organs, r)];
@@ -372,7 +359,7 @@ LevelSolution InstancedSolve::Solve(std::uint32_t p, const Level& level,
                                      level.closed, std::move(problem));
     // Its receivers' light, where the scene has them.
     const FlatScene& flat = level.flat;
-    const std::uint32_t organs = OrganCount(flat);
+    const std::uint32_t organs = LeadingOrgans(flat);
     for (std::uint32_t r = 0; r < OwnReceivers(p, flat); ++r) {
         Emit(Global(flat, organs, r), light.solution.light[r]);
     }

@@ -147,9 +147,9 @@ SceneSignatures ComputeSignatures(const Scene& scene, const InstancingPolicy& po
         return policy.attributes[a].name < policy.attributes[b].name;
     });
 
-    std::optional<Topology> topology;
-    if (!InWalkOrder(scene)) topology.emplace(scene);
-    const std::vector<std::uint32_t> leaves = LeavesUnder(scene, topology ? &*topology : nullptr);
+    const std::optional<Topology> topology = TopologyUnlessInWalkOrder(scene);
+    const Topology* walk = topology ? &*topology : nullptr;
+    const std::vector<std::uint32_t> leaves = LeavesUnder(scene, walk);
     SceneSignatures result;
     std::vector<bool> carried(policy.attributes.size(), false);
     const auto classify = [&](std::size_t i, double inclination) {
@@ -163,15 +163,10 @@ SceneSignatures ComputeSignatures(const Scene& scene, const InstancingPolicy& po
         if (unbinned || !s.signature.empty()) result.structures.push_back(std::move(s));
     };
     if (policy.inclination.Used()) {
-        const auto visit = [&](const Node& node, const glm::dmat4& worldFromLocal) {
+        ForEachWorldFrame(scene, walk, [&](const Node& node, const glm::dmat4& worldFromLocal) {
             classify(static_cast<std::size_t>(&node - scene.nodes.data()),
                      Inclination(worldFromLocal));
-        };
-        if (topology) {
-            ForEachWorldFrame(scene, *topology, visit);
-        } else {
-            ForEachWorldFrame(scene, visit);  // without one
-        }
+        });
     } else {
         for (std::size_t i = 0; i < scene.nodes.size(); ++i) classify(i, 0.0);
     }

@@ -178,6 +178,19 @@ FlatScene ReceiversOf(const Scene& scene) {
     return out.Finish();
 }
 
+std::uint32_t LeadingOrgans(const FlatScene& flat) {
+    std::uint32_t organs = 0;
+    while (organs < flat.receivers.size() && flat.receivers[organs].kind == ReceiverKind::kOrgan)
+        ++organs;
+    return organs;
+}
+
+std::uint32_t LeadingOrganTriangles(const FlatScene& flat) {
+    const std::uint32_t organs = LeadingOrgans(flat);
+    if (organs == flat.receivers.size()) return static_cast<std::uint32_t>(flat.triangles.size());
+    return flat.receivers[organs].firstTriangle;
+}
+
 const Mesh& ReceiverMesh(const Scene& scene, const Receiver& receiver) {
     if (receiver.kind == ReceiverKind::kOrgan)
         return *scene.nodes.at(receiver.declared).organ()->mesh;

@@ -68,6 +68,10 @@ FlatScene Flatten(const Scene& scene);
 // triangle ranges, and the frame (origin, bounds). What per-receiver results are indexed by
 // when the scene is never flattened whole (the instanced solver).
 FlatScene ReceiversOf(const Scene& scene);
+// The organ receivers a flat scene lists first (ReceiversOf, Flatten and an instanced
+// level's scene put them there), and their triangles, the first ones.
+std::uint32_t LeadingOrgans(const FlatScene& flat);
+std::uint32_t LeadingOrganTriangles(const FlatScene& flat);
 // The mesh a receiver of the scene's flat scene has: its organ's, surface's or emitter's.
 const Mesh& ReceiverMesh(const Scene& scene, const Receiver& receiver);
 // The scene's vertices placed once each: every receiver's mesh's positions as Flatten

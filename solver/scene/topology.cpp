@@ -71,4 +71,9 @@ bool InWalkOrder(const Scene& scene) {
     return true;
 }
 
+std::optional<Topology> TopologyUnlessInWalkOrder(const Scene& scene) {
+    if (InWalkOrder(scene)) return std::nullopt;
+    return Topology(scene);
+}
+
 }  // namespace leaflux

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -41,6 +42,8 @@ class Topology {
 // the nodes on the way down to the one at hand only: on the paper's plantation a topology
 // took 52 MB (12 bytes a node) at the instanced solve's peak.
 bool InWalkOrder(const Scene& scene);
+// The scene's Topology when its nodes are not InWalkOrder; none when they are.
+std::optional<Topology> TopologyUnlessInWalkOrder(const Scene& scene);
 
 // Each node in that walk's order as visit(i, above): its index in Scene::nodes and those
 // of the nodes above it, its root first. `topology`: the scene's, or null when the scene

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -55,52 +56,55 @@ void Compose(const glm::dmat4& parent, const Frame& local, glm::dmat4& frame) {
 
 void ForEachWorldFrame(const Scene& scene,
                        const std::function<void(const Node&, const glm::dmat4&)>& visit) {
-    if (!InWalkOrder(scene)) {
-        ForEachWorldFrame(scene, Topology(scene), visit);
-        return;
-    }
-    // The same visits in the same order, the frames of the nodes on the way down held: a
-    // topology took 12 bytes a node (52 MB on the paper's plantation, at its peak).
-    std::vector<std::pair<NodeId, glm::dmat4>> down;
-    for (const Node& node : scene.nodes) {
-        if (node.parent == kNoParent) {
-            down.clear();
-            down.push_back({node.id, glm::dmat4(node.parentFromLocal())});
-        } else {
-            while (down.back().first != node.parent) down.pop_back();
-            glm::dmat4 frame;
-            Compose(down.back().second, node.parentFromLocal(), frame);
-            down.push_back({node.id, frame});
-        }
-        visit(node, down.back().second);
-    }
+    const std::optional<Topology> topology = TopologyUnlessInWalkOrder(scene);
+    ForEachWorldFrame(scene, topology ? &*topology : nullptr, visit);
 }
 
 void ForEachWorldFrame(const Scene& scene, const Topology& topology,
                        const std::function<void(const Node&, const glm::dmat4&)>& visit) {
-    for (const std::uint32_t root : topology.Roots())
-        ForEachFrameUnder(scene, topology, root, glm::dmat4(scene.nodes[root].parentFromLocal()),
-                          visit);
+    ForEachWorldFrame(scene, &topology, visit);
 }
 
-void ForEachFrameUnder(const Scene& scene, std::size_t root, const glm::dmat4& rootFrame,
+void ForEachWorldFrame(const Scene& scene, const Topology* topology,
                        const std::function<void(const Node&, const glm::dmat4&)>& visit) {
-    std::vector<std::pair<NodeId, glm::dmat4>> down{{scene.nodes[root].id, rootFrame}};
-    visit(scene.nodes[root], rootFrame);
-    for (std::size_t i = root + 1; i < scene.nodes.size(); ++i) {
-        const Node& node = scene.nodes[i];
-        while (!down.empty() && down.back().first != node.parent) down.pop_back();
-        if (down.empty()) return;  // past the subtree
-        glm::dmat4 frame;
-        Compose(down.back().second, node.parentFromLocal(), frame);
-        down.push_back({node.id, frame});
-        visit(node, down.back().second);
-    }
+    // The frames of the nodes on the way down to the one at hand, by depth: a node's frame
+    // is its parent's, the last one, times its own.
+    std::vector<glm::dmat4> frames;
+    ForEachNodeDown(scene, topology, [&](std::uint32_t i, std::span<const std::uint32_t> above) {
+        const Frame& local = scene.nodes[i].parentFromLocal();
+        frames.resize(above.size() + 1);
+        if (above.empty()) {
+            frames[0] = glm::dmat4(local);
+        } else {
+            Compose(frames[above.size() - 1], local, frames.back());
+        }
+        visit(scene.nodes[i], frames.back());
+    });
 }
 
 void ForEachFrameUnder(const Scene& scene, const Topology& topology, std::size_t root,
                        const glm::dmat4& rootFrame,
                        const std::function<void(const Node&, const glm::dmat4&)>& visit) {
+    ForEachFrameUnder(scene, &topology, root, rootFrame, visit);
+}
+
+void ForEachFrameUnder(const Scene& scene, const Topology* topology, std::size_t root,
+                       const glm::dmat4& rootFrame,
+                       const std::function<void(const Node&, const glm::dmat4&)>& visit) {
+    if (topology == nullptr) {  // in walk order: the nodes from the root on, while under it
+        std::vector<std::pair<NodeId, glm::dmat4>> down{{scene.nodes[root].id, rootFrame}};
+        visit(scene.nodes[root], rootFrame);
+        for (std::size_t i = root + 1; i < scene.nodes.size(); ++i) {
+            const Node& node = scene.nodes[i];
+            while (!down.empty() && down.back().first != node.parent) down.pop_back();
+            if (down.empty()) return;  // past the subtree
+            glm::dmat4 frame;
+            Compose(down.back().second, node.parentFromLocal(), frame);
+            down.push_back({node.id, frame});
+            visit(node, down.back().second);
+        }
+        return;
+    }
     // Depth first: the nodes to visit with their depths below the root, and the frame of
     // the last node visited at each depth, which is the parent's of the next node popped
     // one deeper. A waiting node takes 8 bytes, not its frame's 136: on the 119k-triangle
@@ -117,7 +121,7 @@ void ForEachFrameUnder(const Scene& scene, const Topology& topology, std::size_t
             Compose(frames[depth - 1], node.parentFromLocal(), frames[depth]);
         }
         visit(node, frames[depth]);
-        const std::span<const std::uint32_t> children = topology.Children(i);
+        const std::span<const std::uint32_t> children = topology->Children(i);
         for (auto c = children.rbegin(); c != children.rend(); ++c)
             stack.push_back({*c, depth + 1});
     }

@@ -39,8 +39,10 @@ class WorldFrames {
 // whose parent links loop or lead to no node are not visited.
 void ForEachWorldFrame(const Scene& scene,
                        const std::function<void(const Node&, const glm::dmat4&)>& visit);
-// The same over the scene's topology, when the caller has it.
+// The same over the scene's topology, when the caller has it; null for a scene InWalkOrder.
 void ForEachWorldFrame(const Scene& scene, const Topology& topology,
+                       const std::function<void(const Node&, const glm::dmat4&)>& visit);
+void ForEachWorldFrame(const Scene& scene, const Topology* topology,
                        const std::function<void(const Node&, const glm::dmat4&)>& visit);
 // Each node of the subtree under node `root` (its index in Scene::nodes), in the same
 // order, with its frame in the one `rootFrame` is given in: the root's is rootFrame, each
@@ -49,9 +51,10 @@ void ForEachWorldFrame(const Scene& scene, const Topology& topology,
 void ForEachFrameUnder(const Scene& scene, const Topology& topology, std::size_t root,
                        const glm::dmat4& rootFrame,
                        const std::function<void(const Node&, const glm::dmat4&)>& visit);
-// The same for a scene InWalkOrder, without its topology: the subtree is the nodes from
-// `root` on while they lie under it.
-void ForEachFrameUnder(const Scene& scene, std::size_t root, const glm::dmat4& rootFrame,
+// `topology` null for a scene InWalkOrder: the subtree is the nodes from `root` on while
+// they lie under it.
+void ForEachFrameUnder(const Scene& scene, const Topology* topology, std::size_t root,
+                       const glm::dmat4& rootFrame,
                        const std::function<void(const Node&, const glm::dmat4&)>& visit);
 
 // worldFromLocal of every node, by id. Requires a validated scene (no cycles).
